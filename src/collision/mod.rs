@@ -1,0 +1,27 @@
+//! Collision of convex robot links ("targets") with thickness cells.
+//!
+//! The narrow phase is a separating-axis test, as in the claim: project both shapes on an axis,
+//! and if `Amax <= Bmin` or `Bmax <= Amin` on any axis they are apart (touching is not a
+//! collision). The candidate axes make the test exact:
+//! - convex polytopes (boxes, mesh hulls): the face normals of both, and the cross products of
+//!   edge pairs that form a face of the Minkowski difference (the Gauss-map test of Gregorius,
+//!   GDC 2013), which prunes the `E_a x E_b` pairs to the few that matter;
+//! - spheres and capsules: the cell's face normals, the cross products of the capsule's axis with
+//!   the cell's edges, and the closest-feature directions (vertex and edge to the sphere centre or
+//!   the capsule's segment), which cover every face, edge and vertex of the Minkowski difference;
+//! - cylinders have no finite exact axis set: they are decided with parry's GJK/EPA.
+//!
+//! The broad phase is parry's BVH over each object's cells. What is reported is in `report`.
+
+mod cell_contact;
+mod contact_point;
+mod polytope;
+mod report;
+mod sat;
+mod scene;
+mod target;
+
+pub use self::cell_contact::{collide_target_cell, CellHit};
+pub use self::report::{CollideSettings, Contact, TargetReport};
+pub use self::scene::{Scene, SceneObject};
+pub use self::target::{ConvexHull, Target, TargetShape};

@@ -1,0 +1,139 @@
+//! The environment: objects with their cells in a BVH, and the queries against them.
+
+use super::cell_contact::LocalPair;
+use super::report::{CollideSettings, Contact, TargetReport};
+use super::target::Target;
+use crate::math::{Aabb, Pose, Real, Vector};
+use crate::thickness::ThicknessArea;
+use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+
+/// One environment object: a thin surface with its cells, fixed in the world.
+pub struct SceneObject {
+    /// The object's name (reported in contacts).
+    pub name: String,
+    /// The pose of the object's frame (the frame of its cells) in the world.
+    pub pose: Pose,
+    /// Its cells.
+    pub area: ThicknessArea,
+    bvh: Bvh,
+}
+
+impl SceneObject {
+    /// Bytes of the BVH (for memory reports).
+    pub fn bvh_memory(&self) -> usize {
+        self.bvh.total_memory_size()
+    }
+}
+
+/// Environment objects and the queries of convex targets against them.
+#[derive(Default)]
+pub struct Scene {
+    objects: Vec<SceneObject>,
+}
+
+/// The bounding box of a cell; parry's BVH compares with `<=`, so no rounding is needed in f64.
+fn cell_aabb(cell: &crate::thickness::ThicknessCell) -> Aabb {
+    let v = cell.vertices();
+    let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    Aabb::new(lo, hi)
+}
+
+impl Scene {
+    /// An empty scene.
+    pub fn new() -> Scene {
+        Scene::default()
+    }
+
+    /// Adds a thin surface whose cells are given in the object's frame, placed at `pose` in the
+    /// world. Returns the object's index.
+    pub fn add_surface(&mut self, name: impl Into<String>, pose: Pose, area: ThicknessArea) -> usize {
+        let aabbs: Vec<Aabb> = area.cells.iter().map(cell_aabb).collect();
+        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs);
+        self.objects.push(SceneObject { name: name.into(), pose, area, bvh });
+        self.objects.len() - 1
+    }
+
+    /// The objects, in the order they were added.
+    pub fn objects(&self) -> &[SceneObject] {
+        &self.objects
+    }
+
+    /// Checks one target against every object.
+    ///
+    /// ```
+    /// use thickness_collision::collision::{CollideSettings, Scene, Target, TargetShape};
+    /// use thickness_collision::math::{Pose, Vector};
+    /// use thickness_collision::mesh::{generate, MeshTopology, TopologySettings};
+    /// use thickness_collision::thickness::{ThicknessArea, ThicknessSettings};
+    /// let (v, t) = generate::flat_grid(10, 10, 1.0, 1.0);
+    /// let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).unwrap();
+    /// let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: 0.02, ..Default::default() }).unwrap();
+    /// let mut scene = Scene::new();
+    /// scene.add_surface("sheet", Pose::IDENTITY, area);
+    /// // A 4 cm box wholly behind the sheet (its top 5 mm below the surface): a mesh checker
+    /// // sees nothing, the cells see it 45 mm deep.
+    /// let cube = TargetShape::cuboid(Vector::splat(0.02)).unwrap();
+    /// let link = Target::new(cube, Pose::from_translation(Vector::new(0.5, 0.5, -0.025)));
+    /// let report = scene.collide(&link, &CollideSettings::default());
+    /// assert!(report.in_collision());
+    /// assert!((report.deepest().unwrap().depth - 0.045).abs() < 1e-9);
+    /// ```
+    pub fn collide(&self, target: &Target, settings: &CollideSettings) -> TargetReport {
+        self.collide_filtered(target, settings, |_| true)
+    }
+
+    /// Checks one target against the objects for which `check(object index)` is true.
+    pub fn collide_filtered(&self, target: &Target, settings: &CollideSettings, check: impl Fn(usize) -> bool) -> TargetReport {
+        let mut report = TargetReport::default();
+        // The deepest contact so far, its point computed only at the end.
+        let mut deepest: Option<(Contact, usize)> = None;
+        for (oi, object) in self.objects.iter().enumerate() {
+            if !check(oi) {
+                continue;
+            }
+            let target_in_object = object.pose.inv_mul(&target.pose);
+            let object_in_target = target_in_object.inverse();
+            let aabb = target.aabb_in(&target_in_object);
+            let mut hit_object = false;
+            for leaf in object.bvh.intersect_aabb(&aabb) {
+                report.candidates += 1;
+                let cell = &object.area.cells[leaf as usize];
+                let pair = LocalPair::new(target, cell, &object_in_target);
+                let Some(sat) = pair.sat() else { continue };
+                hit_object = true;
+                let rot = target.pose.rotation;
+                let nan = Vector::splat(Real::NAN);
+                if settings.flag_only {
+                    report.objects.push(oi);
+                    report.contacts.push(Contact { object: oi, triangle: cell.triangle, depth: Real::NAN, normal: nan, position: nan, overlap: sat.overlap, axis: rot * sat.axis });
+                    return report;
+                }
+                let (push, depth) = pair.depth(object.area.side);
+                let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: nan, overlap: sat.overlap, axis: rot * sat.axis };
+                if settings.all_contacts {
+                    contact.position = pair.point(push).map_or(nan, |p| target.pose * p);
+                    report.contacts.push(contact);
+                } else if deepest.as_ref().map_or(true, |(d, _)| depth > d.depth) {
+                    deepest = Some((contact, leaf as usize));
+                }
+            }
+            if hit_object {
+                report.objects.push(oi);
+            }
+        }
+        if let Some((mut contact, leaf)) = deepest {
+            let object = &self.objects[contact.object];
+            let object_in_target = target.pose.inv_mul(&object.pose);
+            let pair = LocalPair::new(target, &object.area.cells[leaf], &object_in_target);
+            let push = target.pose.rotation.inverse() * contact.normal;
+            contact.position = pair.point(push).map_or(Vector::splat(Real::NAN), |p| target.pose * p);
+            report.contacts.push(contact);
+        }
+        report
+    }
+
+    /// Checks several targets (one report each, in order).
+    pub fn collide_many(&self, targets: &[Target], settings: &CollideSettings) -> Vec<TargetReport> {
+        targets.iter().map(|t| self.collide(t, settings)).collect()
+    }
+}

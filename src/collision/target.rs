@@ -1,0 +1,222 @@
+//! Convex targets: the shapes robot links are checked as.
+
+use crate::math::{Aabb, Pose, Real, Vector};
+use parry3d_f64::shape::ConvexPolyhedron;
+use std::sync::Arc;
+
+/// One face of a hull: outward unit normal and the hull's extent along it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HullFace {
+    pub normal: Vector,
+    /// `max normal . x` over the hull (the face's own plane).
+    pub max: Real,
+    /// `min normal . x` over the hull.
+    pub min: Real,
+}
+
+/// One edge of a hull with the outward normals of its two faces (for the Gauss-map test).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HullEdge {
+    pub point: Vector,
+    pub dir: Vector,
+    pub n1: Vector,
+    pub n2: Vector,
+}
+
+/// A convex polytope in its own frame, with what the separating-axis test needs precomputed.
+#[derive(Clone, Debug)]
+pub struct ConvexHull {
+    pub(crate) points: Vec<Vector>,
+    pub(crate) faces: Vec<HullFace>,
+    pub(crate) edges: Vec<HullEdge>,
+    pub(crate) centroid: Vector,
+    pub(crate) aabb: Aabb,
+    parry: ConvexPolyhedron,
+}
+
+impl ConvexHull {
+    /// The convex hull of `points` (at least 4 points not in one plane), with coplanar faces merged.
+    pub fn from_points(points: &[Vector]) -> Option<ConvexHull> {
+        if points.len() < 4 || points.iter().any(|p| !p.is_finite()) {
+            return None;
+        }
+        Self::from_parry(ConvexPolyhedron::from_convex_hull(points)?)
+    }
+
+    /// An axis-aligned box `[-half, half]`.
+    pub fn cuboid(half_extents: Vector) -> Option<ConvexHull> {
+        let h = half_extents;
+        if !(h.min_element() > 0.0) {
+            return None;
+        }
+        let corners: Vec<Vector> =
+            (0..8).map(|i| Vector::new(if i & 1 == 0 { -h.x } else { h.x }, if i & 2 == 0 { -h.y } else { h.y }, if i & 4 == 0 { -h.z } else { h.z })).collect();
+        Self::from_points(&corners)
+    }
+
+    fn from_parry(parry: ConvexPolyhedron) -> Option<ConvexHull> {
+        let points = parry.points().to_vec();
+        let (lo, hi) = points.iter().fold((Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let centroid = points.iter().copied().sum::<Vector>() / points.len() as Real;
+        let adj = parry.vertices_adj_to_face();
+        let faces: Vec<HullFace> = parry
+            .faces()
+            .iter()
+            .map(|f| {
+                let on_face = points[adj[f.first_vertex_or_edge as usize] as usize];
+                let min = points.iter().map(|p| f.normal.dot(*p)).fold(Real::INFINITY, Real::min);
+                HullFace { normal: f.normal, max: f.normal.dot(on_face), min }
+            })
+            .collect();
+        let edges = parry
+            .edges()
+            .iter()
+            .map(|e| HullEdge {
+                point: points[e.vertices[0] as usize],
+                dir: (points[e.vertices[1] as usize] - points[e.vertices[0] as usize]).normalize(),
+                n1: faces[e.faces[0] as usize].normal,
+                n2: faces[e.faces[1] as usize].normal,
+            })
+            .collect();
+        if faces.len() < 4 || !centroid.is_finite() {
+            return None;
+        }
+        Some(ConvexHull { points, faces, edges, centroid, aabb: Aabb::new(lo, hi), parry })
+    }
+
+    /// The hull's vertices.
+    pub fn points(&self) -> &[Vector] {
+        &self.points
+    }
+
+    /// Number of faces (coplanar triangles merged).
+    pub fn face_count(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// The same hull as a parry shape (for GJK-based queries and as a test oracle).
+    pub fn as_parry(&self) -> &ConvexPolyhedron {
+        &self.parry
+    }
+
+    /// `[min, max]` of `dir . x` over the hull.
+    #[inline]
+    pub(crate) fn project(&self, dir: Vector) -> [Real; 2] {
+        let mut lo = Real::INFINITY;
+        let mut hi = Real::NEG_INFINITY;
+        for p in &self.points {
+            let d = dir.dot(*p);
+            lo = lo.min(d);
+            hi = hi.max(d);
+        }
+        [lo, hi]
+    }
+}
+
+/// The shape of a target, in the target's own frame. Capsules and cylinders run along local `z`
+/// and are centred at the origin, as in URDF.
+#[derive(Clone, Debug)]
+pub enum TargetShape {
+    /// A convex polytope (a box, or the convex hull of a link mesh).
+    Polytope(Arc<ConvexHull>),
+    /// A ball centred at the origin.
+    Sphere {
+        /// Radius (metres).
+        radius: Real,
+    },
+    /// A capsule from `(0, 0, -half_height)` to `(0, 0, half_height)`.
+    Capsule {
+        /// Half the length of the segment (metres).
+        half_height: Real,
+        /// Radius (metres).
+        radius: Real,
+    },
+    /// A cylinder along `z`, from `-half_height` to `half_height`.
+    Cylinder {
+        /// Half the length (metres).
+        half_height: Real,
+        /// Radius (metres).
+        radius: Real,
+    },
+}
+
+impl TargetShape {
+    /// A box with the given half extents (metres); `None` unless all are positive.
+    pub fn cuboid(half_extents: Vector) -> Option<TargetShape> {
+        Some(TargetShape::Polytope(Arc::new(ConvexHull::cuboid(half_extents)?)))
+    }
+
+    /// Bounding box in the shape's frame.
+    pub fn local_aabb(&self) -> Aabb {
+        match self {
+            TargetShape::Polytope(h) => h.aabb,
+            TargetShape::Sphere { radius } => Aabb::new(Vector::splat(-radius), Vector::splat(*radius)),
+            TargetShape::Capsule { half_height, radius } | TargetShape::Cylinder { half_height, radius } => {
+                let extra = if matches!(self, TargetShape::Capsule { .. }) { *radius } else { 0.0 };
+                let h = Vector::new(*radius, *radius, half_height + extra);
+                Aabb::new(-h, h)
+            }
+        }
+    }
+
+    /// `[min, max]` of `dir . x` over the shape (in its frame).
+    #[inline]
+    pub(crate) fn project(&self, dir: Vector) -> [Real; 2] {
+        let r = match self {
+            TargetShape::Polytope(h) => return h.project(dir),
+            TargetShape::Sphere { radius } => dir.length() * radius,
+            TargetShape::Capsule { half_height, radius } => (half_height * dir.z).abs() + dir.length() * radius,
+            TargetShape::Cylinder { half_height, radius } => (half_height * dir.z).abs() + radius * dir.x.hypot(dir.y),
+        };
+        [-r, r]
+    }
+
+    /// A point inside the shape that names "its centre" (the centroid of a hull, else the origin).
+    pub(crate) fn centre(&self) -> Vector {
+        match self {
+            TargetShape::Polytope(h) => h.centroid,
+            _ => Vector::ZERO,
+        }
+    }
+
+    /// Whether the shape's sizes are positive and finite.
+    pub fn is_valid(&self) -> bool {
+        match self {
+            TargetShape::Polytope(_) => true,
+            TargetShape::Sphere { radius } => *radius > 0.0 && radius.is_finite(),
+            TargetShape::Capsule { half_height, radius } | TargetShape::Cylinder { half_height, radius } => {
+                *radius > 0.0 && radius.is_finite() && *half_height >= 0.0 && half_height.is_finite()
+            }
+        }
+    }
+}
+
+/// A posed convex shape: a robot link (or part of one) in the world.
+#[derive(Clone, Debug)]
+pub struct Target {
+    /// The shape in its own frame.
+    pub shape: TargetShape,
+    /// The pose of the shape's frame in the world.
+    pub pose: Pose,
+}
+
+impl Target {
+    /// A target.
+    pub fn new(shape: TargetShape, pose: Pose) -> Target {
+        Target { shape, pose }
+    }
+
+    /// Bounding box of the target seen from a frame in which the target has pose `pos`.
+    pub fn aabb_in(&self, pos: &Pose) -> Aabb {
+        let local = self.shape.local_aabb();
+        let c = pos * local.center();
+        let h = local.half_extents();
+        let m = parry3d_f64::math::Matrix::from_quat(pos.rotation);
+        let e = Vector::new(
+            m.row(0).abs().dot(h),
+            m.row(1).abs().dot(h),
+            m.row(2).abs().dot(h),
+        );
+        Aabb::new(c - e, c + e)
+    }
+}

@@ -1,0 +1,17 @@
+//! `thickness_collision`: reliable collision checks against thin surface meshes.
+//!
+//! A one-layer triangle mesh (a sheet-metal guard, a shelf, a scanned wall) has no inside, so a
+//! robot link sampled between two states can pass through it unseen. This crate gives every
+//! triangle a *thickness area* — a convex cell whose side walls are shared with its neighbours —
+//! and checks convex robot links against the cells with a separating-axis test behind a BVH.
+//!
+//! The layers point one way: [`mesh`] (topology) ← [`thickness`] (cells) ← [`collision`]
+//! (targets, SAT, scene) ← [`model`] (files). The geometry core knows nothing of files or ROS.
+#![warn(missing_docs)]
+#![deny(unused_results)]
+
+pub mod collision;
+pub mod math;
+pub mod mesh;
+pub mod model;
+pub mod thickness;

@@ -1,0 +1,42 @@
+//! The one place that picks the scalar and the vector types.
+//!
+//! The core works in `f64`: cells are thin (a few millimetres) next to workcells of several metres,
+//! and the shared-wall property is checked at 1e-9 of the mesh size, which `f32` cannot hold. The
+//! types are parry's (`parry3d-f64`, glam underneath), so that the BVH and the test oracle take them
+//! without conversion. A parry upgrade touches this file only.
+
+pub use parry3d_f64::math::{Pose, Real, Rotation, Vector};
+
+/// Axis-aligned bounding box, as the BVH wants it.
+pub use parry3d_f64::bounding_volume::Aabb;
+
+/// The unit vector along `v`, or `None` when `v` is too short to have a direction.
+#[inline]
+pub fn try_normalize(v: Vector, min_len: Real) -> Option<Vector> {
+    let len = v.length();
+    if len > min_len && len.is_finite() {
+        Some(v / len)
+    } else {
+        None
+    }
+}
+
+/// Solves `[n0; n1; n2] x = [d0, d1, d2]` (three planes `n_i . x = d_i`) by Cramer's rule.
+///
+/// Returns `None` when the normals are linearly dependent relative to their lengths
+/// (`|det| <= eps * |n0||n1||n2|`): the planes do not meet in one point.
+#[inline]
+pub fn intersect_three_planes(n: [Vector; 3], d: [Real; 3], eps: Real) -> Option<Vector> {
+    let c12 = n[1].cross(n[2]);
+    let det = n[0].dot(c12);
+    let scale = n[0].length() * n[1].length() * n[2].length();
+    if !(det.abs() > eps * scale) {
+        return None;
+    }
+    let x = (c12 * d[0] + n[2].cross(n[0]) * d[1] + n[0].cross(n[1]) * d[2]) / det;
+    if x.is_finite() {
+        Some(x)
+    } else {
+        None
+    }
+}
