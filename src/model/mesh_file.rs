@@ -21,7 +21,7 @@ pub struct MeshData {
 #[non_exhaustive]
 pub enum MeshFileError {
     /// The file cannot be read.
-    #[error("cannot read mesh file {path}: {source}")]
+    #[error("cannot read mesh file {path}")]
     Io {
         /// The file.
         path: PathBuf,
