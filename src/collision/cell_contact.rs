@@ -50,26 +50,6 @@ impl<'a> LocalPair<'a> {
         }
     }
 
-    /// The push-out normal (target frame) and depth for a thin-surface cell of the given side.
-    #[inline]
-    pub fn depth(&self, side: Side) -> (Vector, Real) {
-        let n = self.cell.normal;
-        let push = match side {
-            Side::Back => n,
-            Side::Front => -n,
-            Side::Both => {
-                if n.dot(self.target.shape.centre()) >= self.cell.plane_offset {
-                    n
-                } else {
-                    -n
-                }
-            }
-        };
-        let b_max = self.cell.project(push)[1];
-        let a_min = self.target.shape.project(push)[0];
-        (push, b_max - a_min)
-    }
-
     /// A point of the overlap, deepest along `-push` (target frame).
     pub fn point(&self, push: Vector) -> Option<Vector> {
         match &self.target.shape {
@@ -93,6 +73,27 @@ impl<'a> LocalPair<'a> {
     }
 }
 
+/// The SAT on the cell's own normal, first and alone because it is cheap (no cell transform) and
+/// separates most candidates beside a surface. `None` when it separates; else the push-out normal
+/// (target frame) and the depth the pair reports if it collides: the claim's `Bmax - Amin` on that
+/// axis. `pos12` is the pose of the cell's object in the target's frame.
+#[inline]
+pub(crate) fn normal_axis(target: &Target, cell: &ThicknessCell, side: Side, pos12: &Pose) -> Option<(Vector, Real)> {
+    let n = pos12.rotation * cell.normal;
+    let shift = n.dot(pos12.translation);
+    let [b_min, b_max] = cell.normal_range().map(|x| x + shift);
+    let [a_min, a_max] = target.shape.project(n);
+    if a_max <= b_min || b_max <= a_min || !(a_min.is_finite() && a_max.is_finite()) {
+        return None;
+    }
+    let front = match side {
+        Side::Back => true,
+        Side::Front => false,
+        Side::Both => n.dot(target.shape.centre()) >= cell.plane_offset + shift,
+    };
+    Some(if front { (n, b_max - a_min) } else { (-n, a_max - b_min) })
+}
+
 /// Checks one target against one cell of an object posed at `object_pose`, for a thin surface of
 /// the given `side`. With `want_point` the contact point is computed (clipping, the costly part).
 ///
@@ -113,9 +114,10 @@ impl<'a> LocalPair<'a> {
 /// assert!(collide_target_cell(&ball, &area.cells[0], Side::Back, &Pose::IDENTITY, false).is_none());
 /// ```
 pub fn collide_target_cell(target: &Target, cell: &ThicknessCell, side: Side, object_pose: &Pose, want_point: bool) -> Option<CellHit> {
-    let pair = LocalPair::new(target, cell, &target.pose.inv_mul(object_pose));
+    let pos12 = target.pose.inv_mul(object_pose);
+    let (push, depth) = normal_axis(target, cell, side, &pos12)?;
+    let pair = LocalPair::new(target, cell, &pos12);
     let sat = pair.sat()?;
-    let (push, depth) = pair.depth(side);
     let rot = target.pose.rotation;
     let point = if want_point { pair.point(push).map(|p| target.pose * p) } else { None };
     Some(CellHit { depth, normal: rot * push, overlap: sat.overlap, axis: rot * sat.axis, point })

@@ -21,9 +21,6 @@ pub(crate) struct CellPolytope {
     pub planes: [(Vector, Real); 5],
     pub edges: [CellEdge; 9],
     pub edge_count: usize,
-    /// The face's front normal and the face plane offset, in this frame.
-    pub normal: Vector,
-    pub plane_offset: Real,
     pub back_collapsed: bool,
     pub front_collapsed: bool,
 }
@@ -39,8 +36,6 @@ impl CellPolytope {
             let n2 = rot * n;
             (n2, d + n2.dot(tr))
         });
-        let normal = rot * cell.normal;
-        let plane_offset = cell.plane_offset + normal.dot(tr);
         let back_collapsed = crate::thickness::is_collapsed(&cell.back_cap);
         let front_collapsed = crate::thickness::is_collapsed(&cell.front_cap);
         let mut edges = [CellEdge::default(); 9];
@@ -63,7 +58,7 @@ impl CellPolytope {
             }
             push(verts[i], verts[3 + i], 2 + (i + 2) % 3, 2 + i);
         }
-        CellPolytope { verts, planes, edges, edge_count, normal, plane_offset, back_collapsed, front_collapsed }
+        CellPolytope { verts, planes, edges, edge_count, back_collapsed, front_collapsed }
     }
 
     /// `[min, max]` of `dir . x` over the cell.

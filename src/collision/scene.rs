@@ -1,6 +1,6 @@
 //! The environment: objects with their cells in a BVH, and the queries against them.
 
-use super::cell_contact::LocalPair;
+use super::cell_contact::{normal_axis, LocalPair};
 use super::report::{CollideSettings, Contact, TargetReport};
 use super::target::Target;
 use crate::math::{Aabb, Pose, Real, Vector};
@@ -85,8 +85,11 @@ impl Scene {
     /// Checks one target against the objects for which `check(object index)` is true.
     pub fn collide_filtered(&self, target: &Target, settings: &CollideSettings, check: impl Fn(usize) -> bool) -> TargetReport {
         let mut report = TargetReport::default();
-        // The deepest contact so far, its point computed only at the end.
-        let mut deepest: Option<(Contact, usize)> = None;
+        let nan = Vector::splat(Real::NAN);
+        let rot = target.pose.rotation;
+        let mut deepest: Option<Contact> = None;
+        // Candidates that the normal axis does not separate: (depth if colliding, cell index).
+        let mut survivors: Vec<(Real, u32, Vector)> = Vec::new();
         for (oi, object) in self.objects.iter().enumerate() {
             if !check(oi) {
                 continue;
@@ -94,41 +97,48 @@ impl Scene {
             let target_in_object = object.pose.inv_mul(&target.pose);
             let object_in_target = target_in_object.inverse();
             let aabb = target.aabb_in(&target_in_object);
-            let mut hit_object = false;
+            let side = object.area.side;
+            survivors.clear();
             for leaf in object.bvh.intersect_aabb(&aabb) {
                 report.candidates += 1;
+                if let Some((push, depth)) = normal_axis(target, &object.area.cells[leaf as usize], side, &object_in_target) {
+                    survivors.push((depth, leaf, push));
+                }
+            }
+            if !settings.all_contacts {
+                // Deepest first: the first colliding cell is this object's deepest contact, and
+                // cells shallower than the deepest found so far need no SAT once the object is
+                // known to collide. On a link pushed through a wall this skips ~99% of the SATs.
+                survivors.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
+            }
+            let mut hit_object = false;
+            for &(depth, leaf, push) in &survivors {
                 let cell = &object.area.cells[leaf as usize];
                 let pair = LocalPair::new(target, cell, &object_in_target);
                 let Some(sat) = pair.sat() else { continue };
                 hit_object = true;
-                let rot = target.pose.rotation;
-                let nan = Vector::splat(Real::NAN);
+                let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: nan, overlap: sat.overlap, axis: rot * sat.axis };
                 if settings.flag_only {
                     report.objects.push(oi);
-                    report.contacts.push(Contact { object: oi, triangle: cell.triangle, depth: Real::NAN, normal: nan, position: nan, overlap: sat.overlap, axis: rot * sat.axis });
+                    report.contacts.push(contact);
                     return report;
                 }
-                let (push, depth) = pair.depth(object.area.side);
-                let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: nan, overlap: sat.overlap, axis: rot * sat.axis };
                 if settings.all_contacts {
                     contact.position = pair.point(push).map_or(nan, |p| target.pose * p);
                     report.contacts.push(contact);
-                } else if deepest.as_ref().map_or(true, |(d, _)| depth > d.depth) {
-                    deepest = Some((contact, leaf as usize));
+                } else {
+                    if deepest.as_ref().map_or(true, |d| depth > d.depth) {
+                        contact.position = pair.point(push).map_or(nan, |p| target.pose * p);
+                        deepest = Some(contact);
+                    }
+                    break;
                 }
             }
             if hit_object {
                 report.objects.push(oi);
             }
         }
-        if let Some((mut contact, leaf)) = deepest {
-            let object = &self.objects[contact.object];
-            let object_in_target = target.pose.inv_mul(&object.pose);
-            let pair = LocalPair::new(target, &object.area.cells[leaf], &object_in_target);
-            let push = target.pose.rotation.inverse() * contact.normal;
-            contact.position = pair.point(push).map_or(Vector::splat(Real::NAN), |p| target.pose * p);
-            report.contacts.push(contact);
-        }
+        report.contacts.extend(deepest);
         report
     }
 

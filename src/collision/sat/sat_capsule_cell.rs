@@ -21,7 +21,8 @@ pub(crate) fn sat_capsule_cell(half_height: Real, radius: Real, cell: &CellPolyt
         let s = (half_height * l.z).abs();
         least.add(l, [-s - radius, s + radius], cell.project(l))
     };
-    for (n, _) in &cell.planes {
+    // planes[0] (back cap) and planes[1] (front cap) lie on the same axis: test it once.
+    for (n, _) in &cell.planes[1..] {
         if !axis(*n) {
             return None;
         }

@@ -9,7 +9,8 @@ use crate::collision::target::ConvexHull;
 pub(crate) fn sat_hull_cell(hull: &ConvexHull, cell: &CellPolytope) -> Option<SatOverlap> {
     let mut least = LeastOverlap::new();
     // The cell's planes first: for a link beside a wall the front/back cap separates at once.
-    for (n, _) in &cell.planes {
+    // planes[0] (back cap) and planes[1] (front cap) lie on the same axis: test it once.
+    for (n, _) in &cell.planes[1..] {
         if !least.add(*n, hull.project(*n), cell.project(*n)) {
             return None;
         }

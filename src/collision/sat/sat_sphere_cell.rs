@@ -9,7 +9,8 @@ use crate::math::{Real, Vector};
 pub(crate) fn sat_sphere_cell(radius: Real, cell: &CellPolytope) -> Option<SatOverlap> {
     let mut least = LeastOverlap::new();
     let r = [-radius, radius];
-    for (n, _) in &cell.planes {
+    // planes[0] (back cap) and planes[1] (front cap) lie on the same axis: test it once.
+    for (n, _) in &cell.planes[1..] {
         if !least.add(*n, r, cell.project(*n)) {
             return None;
         }
