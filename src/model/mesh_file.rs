@@ -124,3 +124,19 @@ fn read_binary_stl(bytes: &[u8]) -> MeshData {
     }
     data
 }
+
+/// Writes a mesh as Wavefront OBJ (vertices in metres, faces 1-based, counter-clockwise fronts).
+pub fn write_obj(path: &Path, vertices: &[Vector], triangles: &[[u32; 3]], comment: &str) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    for line in comment.lines() {
+        writeln!(w, "# {line}")?;
+    }
+    for v in vertices {
+        writeln!(w, "v {} {} {}", v.x, v.y, v.z)?;
+    }
+    for t in triangles {
+        writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+    }
+    w.flush()
+}

@@ -1,0 +1,43 @@
+//! The meshes of the bundled example workcell, generated here so that they are reproducible:
+//! `tests/example_workcell.rs` regenerates them and fails if `config/example_workcell/` differs
+//! (run it with `UPDATE_EXAMPLES=1` to rewrite the files).
+
+use crate::math::{Pose, Real, Rotation, Vector};
+use crate::mesh::generate::{self, Soup};
+
+/// Name, description and triangles of each example mesh.
+pub fn example_meshes() -> Vec<(&'static str, &'static str, Soup)> {
+    vec![
+        (
+            "guard_sheet.obj",
+            "Corrugated sheet-metal guard, 1.0 x 0.8 m, 1 cm corrugation, one layer (front +z).",
+            generate::height_field(40, 32, 1.0, 0.8, |x, _| 0.01 * (2.0 * std::f64::consts::PI * x / 0.1).sin()),
+        ),
+        ("shelf.obj", "Open shelf: bottom, back and two sides, 0.6 x 0.4 x 0.3 m, single-layer panels.", shelf(0.6, 0.4, 0.3, 12)),
+        (
+            "bent_panel.obj",
+            "Panel bent along a line at 120 degrees (a ridge seen from the front), 2 x 0.3 m x 0.6 m.",
+            generate::v_fold(120f64.to_radians(), true, 0.3, 0.6, 10),
+        ),
+    ]
+}
+
+/// Four open panels of a shelf, fronts facing the inside, sharing their edges.
+fn shelf(w: Real, d: Real, h: Real, n: usize) -> Soup {
+    let mut v: Vec<Vector> = Vec::new();
+    let mut t: Vec<[u32; 3]> = Vec::new();
+    // `flip` reverses the winding where the rotation leaves the panel's front facing out.
+    let mut add = |soup: Soup, pose: Pose, flip: bool| {
+        let base = v.len() as u32;
+        let (pv, pt) = generate::transformed(soup, &pose);
+        v.extend(pv);
+        t.extend(pt.into_iter().map(|f| if flip { [f[0], f[2], f[1]] } else { f }).map(|f| f.map(|i| i + base)));
+    };
+    let q = std::f64::consts::FRAC_PI_2;
+    // Bottom (front +z), back wall at y = d (front -y), sides at x = 0 (front +x) and x = w (front -x).
+    add(generate::flat_grid(n, n, w, d), Pose::IDENTITY, false);
+    add(generate::flat_grid(n, n, w, h), Pose::from_parts(Vector::new(0.0, d, 0.0), Rotation::from_rotation_x(q)), false);
+    add(generate::flat_grid(n, n, h, d), Pose::from_parts(Vector::ZERO, Rotation::from_rotation_y(-q)), true);
+    add(generate::flat_grid(n, n, h, d), Pose::from_parts(Vector::new(w, d, 0.0), Rotation::from_rotation_z(std::f64::consts::PI) * Rotation::from_rotation_y(-q)), true);
+    (v, t)
+}
