@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 #![deny(unused_results)]
 
+pub mod checker;
 pub mod collision;
 pub mod math;
 pub mod mesh;

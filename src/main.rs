@@ -1,13 +1,12 @@
 //! The `thickness_collision` command line.
 
-use anyhow::{bail, Context, Result};
-use clap::{Parser, Subcommand};
+mod cli;
+
+use anyhow::Result;
+use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use thickness_collision::math::Vector;
-use thickness_collision::mesh::{MeshTopology, TopologySettings};
-use thickness_collision::model::mesh_file::read_mesh;
-use thickness_collision::thickness::{Side, ThicknessArea, ThicknessReport, ThicknessSettings};
+use thickness_collision::thickness::Side;
 
 #[derive(Parser)]
 #[command(name = "thickness_collision", version, about = "Collision checking against thin surfaces with thickness areas")]
@@ -35,6 +34,45 @@ enum Command {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// Check robot states against the environment and print the collisions.
+    Check {
+        #[command(flatten)]
+        model: ModelArgs,
+        /// One state: `joint=value,joint=value,...` (radians / metres).
+        #[arg(long, conflicts_with = "states", required_unless_present_any = ["states", "show_params"])]
+        joints: Option<String>,
+        /// A JSON-lines file of states: `{"name": [...], "position": [...]}` or
+        /// `{"transforms": [{"link": ..., "translation": [x,y,z], "rotation": [x,y,z,w]}]}`.
+        #[arg(long)]
+        states: Option<PathBuf>,
+        /// One JSON object per state on standard output.
+        #[arg(long)]
+        json: bool,
+        /// Print the parameters in force as a ROS 2 parameters file and exit.
+        #[arg(long)]
+        show_params: bool,
+    },
+}
+
+/// Where the robot, the environment and the thin-surface settings come from (shared by
+/// `check`, `run` and `replay`).
+#[derive(Args, Clone, Debug)]
+pub struct ModelArgs {
+    /// A ROS 2 parameters file (`thickness_collision: ros__parameters: ...`).
+    #[arg(long)]
+    params_file: Option<PathBuf>,
+    /// Robot URDF (default: the parameters' `robot_description_file`, else the bundled arm).
+    #[arg(long)]
+    robot: Option<PathBuf>,
+    /// Environment URDF (default: the parameters' `environment_file`, else the bundled workcell).
+    #[arg(long)]
+    environment: Option<PathBuf>,
+    /// Thickness of every thin surface (metres), overriding the parameters.
+    #[arg(long, allow_negative_numbers = true)]
+    thickness: Option<f64>,
+    /// Side of every thin surface, overriding the parameters.
+    #[arg(long, value_enum)]
+    side: Option<Side>,
 }
 
 fn main() -> ExitCode {
@@ -50,81 +88,8 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Areas { mesh, thickness, side, scale, json } => areas(mesh, thickness, side, &scale, json),
+        Command::Areas { mesh, thickness, side, scale, json } => cli::areas::areas(mesh, thickness, side, &scale, json),
+        Command::Check { model, joints, states, json, show_params } => cli::check::check(&model, joints.as_deref(), states.as_deref(), json, show_params),
     }
 }
 
-fn parse_scale(s: &str) -> Result<Vector> {
-    let parts: Vec<f64> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>().with_context(|| format!("--scale: '{p}' is not a number")))
-        .collect::<Result<_>>()?;
-    let v = match parts[..] {
-        [k] => Vector::splat(k),
-        [x, y, z] => Vector::new(x, y, z),
-        _ => bail!("--scale takes one factor or three (sx,sy,sz), got '{s}'"),
-    };
-    if !v.is_finite() || v.x * v.y * v.z == 0.0 {
-        bail!("--scale must be finite and non-zero, got '{s}'");
-    }
-    Ok(v)
-}
-
-fn areas(path: PathBuf, thickness: f64, side: Side, scale: &str, json: Option<PathBuf>) -> Result<()> {
-    if !(thickness > 0.0 && thickness.is_finite()) {
-        bail!("--thickness must be a positive number of metres, got {thickness}");
-    }
-    let scale = parse_scale(scale)?;
-    let data = read_mesh(&path, scale)?;
-    let started = std::time::Instant::now();
-    let mesh = MeshTopology::build(&data.vertices, &data.triangles, &TopologySettings::default())
-        .with_context(|| format!("mesh file {}", path.display()))?;
-    let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() })?;
-    let elapsed = started.elapsed();
-    print_report(&path, &area.report, thickness, side, elapsed);
-    if let Some(out) = json {
-        write_cells_json(&out, &area).with_context(|| format!("cannot write {}", out.display()))?;
-        println!("cells written to {}", out.display());
-    }
-    Ok(())
-}
-
-fn print_report(path: &std::path::Path, r: &ThicknessReport, t: f64, side: Side, elapsed: std::time::Duration) {
-    let topo = &r.topology;
-    println!("{}: {} triangles, {} vertices ({} after welding)", path.display(), topo.input_triangles, topo.input_vertices, topo.vertices);
-    println!("  thickness {t} m, side {}, built in {:.3} ms", side.as_str(), elapsed.as_secs_f64() * 1e3);
-    println!(
-        "  cells {}: tetrahedra {}, ratioed {}, prisms {}, diverging {}",
-        r.cells, r.tetrahedra, r.ratioed, r.prisms, r.diverging
-    );
-    println!(
-        "  skipped: degenerate {}, duplicate {}",
-        r.degenerate_skipped, topo.duplicate_triangles
-    );
-    println!(
-        "  edges: shared {}, boundary {}, non-manifold {}, inconsistent {}, folded {}",
-        topo.shared_edges, r.boundary_edges, r.non_manifold_edges, r.inconsistent_edges, r.folded_edges
-    );
-    println!(
-        "  orientation: {} faces flipped; components closed {}, open {}",
-        r.flipped_faces, topo.closed_components, topo.open_components
-    );
-}
-
-fn write_cells_json(out: &std::path::Path, area: &ThicknessArea) -> Result<()> {
-    use std::io::Write;
-    let file = std::fs::File::create(out)?;
-    let mut w = std::io::BufWriter::new(file);
-    w.write_all(b"{\"cells\": [")?;
-    for (i, cell) in area.cells.iter().enumerate() {
-        if i > 0 {
-            w.write_all(b",")?;
-        }
-        let vertices: Vec<[f64; 3]> = cell.distinct_vertices().iter().map(|v| v.to_array()).collect();
-        let entry = serde_json::json!({ "triangle": cell.triangle, "kind": cell.kind, "vertices": vertices });
-        serde_json::to_writer(&mut w, &entry)?;
-    }
-    w.write_all(b"]}\n")?;
-    w.flush()?;
-    Ok(())
-}

@@ -40,3 +40,20 @@ pub fn intersect_three_planes(n: [Vector; 3], d: [Real; 3], eps: Real) -> Option
         None
     }
 }
+
+/// nalgebra (kinematics) to parry/glam (geometry): the one conversion point.
+pub fn pose_from_isometry(iso: &nalgebra::Isometry3<Real>) -> Pose {
+    let q = iso.rotation.quaternion();
+    let t = iso.translation.vector;
+    Pose::from_parts(Vector::new(t.x, t.y, t.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w))
+}
+
+/// glam/parry to nalgebra.
+pub fn isometry_from_pose(pose: &Pose) -> nalgebra::Isometry3<Real> {
+    let q = pose.rotation;
+    let t = pose.translation;
+    nalgebra::Isometry3::from_parts(
+        nalgebra::Translation3::new(t.x, t.y, t.z),
+        nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(q.w, q.x, q.y, q.z)),
+    )
+}

@@ -23,5 +23,5 @@ mod target;
 
 pub use self::cell_contact::{collide_target_cell, CellHit};
 pub use self::report::{CollideSettings, Contact, TargetReport};
-pub use self::scene::{Scene, SceneObject};
+pub use self::scene::{ObjectBody, Scene, SceneObject};
 pub use self::target::{ConvexHull, Target, TargetShape};

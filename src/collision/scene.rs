@@ -2,26 +2,50 @@
 
 use super::cell_contact::{normal_axis, LocalPair};
 use super::report::{CollideSettings, Contact, TargetReport};
-use super::target::Target;
+use super::target::{Target, TargetShape};
 use crate::math::{Aabb, Pose, Real, Vector};
 use crate::thickness::ThicknessArea;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 
-/// One environment object: a thin surface with its cells, fixed in the world.
+/// What an environment object is made of.
+pub enum ObjectBody {
+    /// A thin surface: its cells in a BVH.
+    Surface {
+        /// The cells, in the object's frame.
+        area: ThicknessArea,
+        /// Broad phase over the cells' bounding boxes.
+        bvh: Bvh,
+    },
+    /// A convex solid (a URDF primitive or a mesh checked as its hull), checked with parry's
+    /// GJK/EPA; its contacts have `triangle = u32::MAX`.
+    Solid(TargetShape),
+}
+
+/// One environment object, fixed in the world.
 pub struct SceneObject {
     /// The object's name (reported in contacts).
     pub name: String,
-    /// The pose of the object's frame (the frame of its cells) in the world.
+    /// The pose of the object's frame in the world.
     pub pose: Pose,
-    /// Its cells.
-    pub area: ThicknessArea,
-    bvh: Bvh,
+    /// Its geometry.
+    pub body: ObjectBody,
 }
 
 impl SceneObject {
-    /// Bytes of the BVH (for memory reports).
+    /// The cells, for a thin surface.
+    pub fn area(&self) -> Option<&ThicknessArea> {
+        match &self.body {
+            ObjectBody::Surface { area, .. } => Some(area),
+            ObjectBody::Solid(_) => None,
+        }
+    }
+
+    /// Bytes of the BVH (for memory reports); 0 for solids.
     pub fn bvh_memory(&self) -> usize {
-        self.bvh.total_memory_size()
+        match &self.body {
+            ObjectBody::Surface { bvh, .. } => bvh.total_memory_size(),
+            ObjectBody::Solid(_) => 0,
+        }
     }
 }
 
@@ -49,7 +73,13 @@ impl Scene {
     pub fn add_surface(&mut self, name: impl Into<String>, pose: Pose, area: ThicknessArea) -> usize {
         let aabbs: Vec<Aabb> = area.cells.iter().map(cell_aabb).collect();
         let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs);
-        self.objects.push(SceneObject { name: name.into(), pose, area, bvh });
+        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Surface { area, bvh } });
+        self.objects.len() - 1
+    }
+
+    /// Adds a convex solid placed at `pose` in the world. Returns the object's index.
+    pub fn add_solid(&mut self, name: impl Into<String>, pose: Pose, shape: TargetShape) -> usize {
+        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Solid(shape) });
         self.objects.len() - 1
     }
 
@@ -94,14 +124,33 @@ impl Scene {
             if !check(oi) {
                 continue;
             }
+            let (area, bvh) = match &object.body {
+                ObjectBody::Surface { area, bvh } => (area, bvh),
+                ObjectBody::Solid(shape) => {
+                    report.candidates += 1;
+                    if let Some(contact) = collide_solid(target, oi, &object.pose, shape) {
+                        report.objects.push(oi);
+                        if settings.flag_only {
+                            report.contacts.push(contact);
+                            return report;
+                        }
+                        if settings.all_contacts {
+                            report.contacts.push(contact);
+                        } else if deepest.as_ref().map_or(true, |d| contact.depth > d.depth) {
+                            deepest = Some(contact);
+                        }
+                    }
+                    continue;
+                }
+            };
             let target_in_object = object.pose.inv_mul(&target.pose);
             let object_in_target = target_in_object.inverse();
             let aabb = target.aabb_in(&target_in_object);
-            let side = object.area.side;
+            let side = area.side;
             survivors.clear();
-            for leaf in object.bvh.intersect_aabb(&aabb) {
+            for leaf in bvh.intersect_aabb(&aabb) {
                 report.candidates += 1;
-                if let Some((push, depth)) = normal_axis(target, &object.area.cells[leaf as usize], side, &object_in_target) {
+                if let Some((push, depth)) = normal_axis(target, &area.cells[leaf as usize], side, &object_in_target) {
                     survivors.push((depth, leaf, push));
                 }
             }
@@ -113,7 +162,7 @@ impl Scene {
             }
             let mut hit_object = false;
             for &(depth, leaf, push) in &survivors {
-                let cell = &object.area.cells[leaf as usize];
+                let cell = &area.cells[leaf as usize];
                 let pair = LocalPair::new(target, cell, &object_in_target);
                 let Some(sat) = pair.sat() else { continue };
                 hit_object = true;
@@ -142,8 +191,26 @@ impl Scene {
         report
     }
 
+    /// Total number of cells over all thin surfaces.
+    pub fn cell_count(&self) -> usize {
+        self.objects.iter().filter_map(|o| o.area()).map(|a| a.cells.len()).sum()
+    }
+
     /// Checks several targets (one report each, in order).
     pub fn collide_many(&self, targets: &[Target], settings: &CollideSettings) -> Vec<TargetReport> {
         targets.iter().map(|t| self.collide(t, settings)).collect()
     }
+}
+
+/// A target against a convex solid, with parry's GJK/EPA: the depth is the penetration depth, the
+/// normal the direction that pushes the target out, the point midway between the two witnesses.
+fn collide_solid(target: &Target, object: usize, object_pose: &Pose, shape: &TargetShape) -> Option<Contact> {
+    let (s1, o1) = target.shape.to_parry();
+    let (s2, o2) = shape.to_parry();
+    let c = parry3d_f64::query::contact(&(target.pose * o1), &*s1, &(*object_pose * o2), &*s2, 0.0).ok().flatten()?;
+    if !(c.dist < 0.0) {
+        return None;
+    }
+    let normal = -c.normal1;
+    Some(Contact { object, triangle: u32::MAX, depth: -c.dist, normal, position: (c.point1 + c.point2) * 0.5, overlap: -c.dist, axis: normal })
 }

@@ -115,6 +115,25 @@ impl ConvexHull {
         Some(ConvexHull { points, faces, edges, centroid, aabb: Aabb::new(lo, hi), adjacency_first, adjacency, extreme, parry })
     }
 
+    /// The hull grown by `padding` metres: every vertex moved out along the normal of each of its
+    /// faces, then hulled again. Every face moves out by exactly `padding`; edges and corners are
+    /// bevelled, short of the rounded Minkowski sum by at most `padding * (1 - cos(a/2))` for a
+    /// dihedral angle `a` between face normals.
+    pub fn padded(&self, padding: Real) -> Option<ConvexHull> {
+        if padding == 0.0 {
+            return Some(self.clone());
+        }
+        let adj = self.parry.vertices_adj_to_face();
+        let mut pts = Vec::new();
+        for f in self.parry.faces() {
+            for k in 0..f.num_vertices_or_edges {
+                let v = self.points[adj[(f.first_vertex_or_edge + k) as usize] as usize];
+                pts.push(v + f.normal * padding);
+            }
+        }
+        Self::from_points(&pts)
+    }
+
     /// The hull's vertices.
     pub fn points(&self) -> &[Vector] {
         &self.points
@@ -238,6 +257,21 @@ impl TargetShape {
         match self {
             TargetShape::Polytope(h) => h.centroid,
             _ => Vector::ZERO,
+        }
+    }
+
+    /// The same shape for parry's GJK/EPA queries, with its pose in this shape's frame (parry's
+    /// cylinders run along `y`).
+    pub fn to_parry(&self) -> (Box<dyn parry3d_f64::shape::Shape>, Pose) {
+        use parry3d_f64::shape::{Ball, Capsule, Cylinder};
+        match self {
+            TargetShape::Polytope(h) => (Box::new(h.as_parry().clone()), Pose::IDENTITY),
+            TargetShape::Sphere { radius } => (Box::new(Ball::new(*radius)), Pose::IDENTITY),
+            TargetShape::Capsule { half_height, radius } => (Box::new(Capsule::new_z(*half_height, *radius)), Pose::IDENTITY),
+            TargetShape::Cylinder { half_height, radius } => (
+                Box::new(Cylinder::new(*half_height, *radius)),
+                Pose::from_rotation(crate::math::Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2)),
+            ),
         }
     }
 

@@ -3,10 +3,17 @@
 //! (run it with `UPDATE_EXAMPLES=1` to rewrite the files).
 
 use crate::math::{Pose, Real, Rotation, Vector};
+
 use crate::mesh::generate::{self, Soup};
 
-/// Name, description and triangles of each example mesh.
-pub fn example_meshes() -> Vec<(&'static str, &'static str, Soup)> {
+/// Name, description and triangles of each example mesh, and whether it is an open (thin) surface.
+pub fn example_meshes() -> Vec<(&'static str, &'static str, Soup, bool)> {
+    let mut out: Vec<(&'static str, &'static str, Soup, bool)> = thin_meshes().into_iter().map(|(n, c, s)| (n, c, s, true)).collect();
+    out.push(("gripper.obj", "Gripper body of the example arm: a closed 6 x 10 x 8 cm box (the arm's mesh link).", generate::cuboid(Vector::new(0.03, 0.05, 0.04), 1), false));
+    out
+}
+
+fn thin_meshes() -> Vec<(&'static str, &'static str, Soup)> {
     vec![
         (
             "guard_sheet.obj",

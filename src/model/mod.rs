@@ -1,4 +1,12 @@
-//! Files: meshes (and, later, URDF) turned into the plain data the core takes.
+//! Files turned into the plain data the core takes: URDF robots and environments, mesh files,
+//! `package://` URIs, the parameters file, and forward kinematics.
 
 pub mod example_workcell;
 pub mod mesh_file;
+mod package;
+mod params;
+mod robot;
+
+pub use self::package::{PackageError, PackageResolver};
+pub use self::params::{bundled_config_dir, glob_match, parse_side, MissingJoint, Padding, Params, ParamsError, ThinSurfaces};
+pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, RobotModel};

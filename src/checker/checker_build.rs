@@ -1,0 +1,299 @@
+//! Loading the robot and the environment and checking states against them.
+
+use super::joint_state::{resolve_positions, JointMemory, StateError};
+use super::state_report::{ReportContact, StateReport};
+use crate::collision::{CollideSettings, ConvexHull, Scene, Target, TargetShape};
+use crate::math::{pose_from_isometry, Pose, Vector};
+use crate::mesh::{MeshTopology, TopologySettings};
+use crate::model::mesh_file::{read_mesh, MeshData, MeshFileError};
+use crate::model::{bundled_config_dir, GeometrySpec, JointKind, ModelError, PackageResolver, Params, ParamsError, RobotModel};
+use crate::thickness::{Side, ThicknessArea, ThicknessSettings};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Why a checker cannot be built.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CheckerError {
+    /// Bad parameters.
+    #[error(transparent)]
+    Params(#[from] ParamsError),
+    /// Bad URDF.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// A mesh file of a link cannot be used.
+    #[error("link '{link}': {source}")]
+    Mesh {
+        /// Link.
+        link: String,
+        /// Why.
+        #[source]
+        source: MeshFileError,
+    },
+    /// A mesh of a link has no usable geometry.
+    #[error("link '{link}': mesh {path}: {message}")]
+    Geometry {
+        /// Link.
+        link: String,
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The convex parts of one checked robot link.
+#[derive(Clone, Debug)]
+pub struct LinkTargets {
+    /// Index of the link in the robot model.
+    pub link: usize,
+    /// Its name.
+    pub name: String,
+    /// Shapes and their poses in the link frame.
+    pub parts: Vec<(TargetShape, Pose)>,
+}
+
+/// What was loaded (printed by the CLI and the node at start).
+#[derive(Clone, Debug, Default)]
+pub struct BuildSummary {
+    /// Robot file (or `robot_description`).
+    pub robot_source: String,
+    /// Environment file.
+    pub environment_source: String,
+    /// Links of the robot.
+    pub robot_links: usize,
+    /// Links checked (with geometry and matching `checked_links`).
+    pub checked_links: usize,
+    /// Thin surfaces (meshes with cells).
+    pub thin_surfaces: usize,
+    /// Convex solids.
+    pub solids: usize,
+    /// Cells in all thin surfaces.
+    pub cells: usize,
+    /// Mesh files read (each once).
+    pub meshes_read: usize,
+    /// Seconds to load and build everything.
+    pub build_seconds: f64,
+}
+
+/// Robot, environment, targets and scene: everything needed to check a state.
+pub struct Checker {
+    /// The parameters in force.
+    pub params: Params,
+    /// The robot.
+    pub robot: RobotModel,
+    /// The checked links' targets.
+    pub targets: Vec<LinkTargets>,
+    /// The environment.
+    pub scene: Scene,
+    /// What was loaded.
+    pub summary: BuildSummary,
+    base: Isometry3<f64>,
+    /// `allowed[target index][object index]`.
+    allowed: Vec<Vec<bool>>,
+}
+
+/// Mesh files read once per build.
+#[derive(Default)]
+struct MeshCache {
+    meshes: HashMap<PathBuf, Arc<MeshData>>,
+}
+
+impl MeshCache {
+    /// The mesh at `path` with `scale` applied (winding reversed for mirroring scales).
+    fn get(&mut self, path: &Path, scale: [f64; 3]) -> Result<MeshData, MeshFileError> {
+        let data = match self.meshes.get(path) {
+            Some(d) => d.clone(),
+            None => {
+                let d = Arc::new(read_mesh(path, Vector::ONE)?);
+                let _ = self.meshes.insert(path.to_owned(), d.clone());
+                d
+            }
+        };
+        let s = Vector::from_array(scale);
+        let mut out = MeshData { vertices: data.vertices.iter().map(|v| *v * s).collect(), triangles: data.triangles.clone() };
+        if s.x * s.y * s.z < 0.0 {
+            for t in &mut out.triangles {
+                t.swap(1, 2);
+            }
+        }
+        Ok(out)
+    }
+}
+
+fn primitive_shape(spec: &GeometrySpec, padding: f64) -> Option<TargetShape> {
+    Some(match spec {
+        GeometrySpec::Box(s) => TargetShape::cuboid(Vector::new(s[0], s[1], s[2]) * 0.5 + Vector::splat(padding))?,
+        GeometrySpec::Sphere(r) => TargetShape::Sphere { radius: r + padding },
+        GeometrySpec::Capsule { radius, length } => TargetShape::Capsule { half_height: length / 2.0, radius: radius + padding },
+        GeometrySpec::Cylinder { radius, length } => TargetShape::Cylinder { half_height: length / 2.0 + padding, radius: radius + padding },
+        GeometrySpec::Mesh { .. } => return None,
+    })
+}
+
+fn base_isometry(p: &[f64]) -> Isometry3<f64> {
+    Isometry3::from_parts(Translation3::new(p[0], p[1], p[2]), UnitQuaternion::from_euler_angles(p[3], p[4], p[5]))
+}
+
+impl Checker {
+    /// Loads the robot and the environment named by the parameters (or the overrides), with
+    /// the bundled example workcell as the default for both.
+    pub fn from_params(params: Params, robot: Option<&Path>, environment: Option<&Path>) -> Result<Checker, CheckerError> {
+        params.validate()?;
+        let resolver = PackageResolver::new(&params.package_map);
+        let config = bundled_config_dir();
+        let pick = |over: Option<&Path>, param: &str, default: &str| -> PathBuf {
+            over.map(Path::to_owned).unwrap_or_else(|| if param.is_empty() { config.join(default) } else { PathBuf::from(param) })
+        };
+        let robot_path = pick(robot, &params.robot_description_file, "example_workcell/robot.urdf");
+        let env_path = pick(environment, &params.environment_file, "example_workcell/environment.urdf");
+        let use_visual = params.use_visual_when_no_collision;
+        let robot = RobotModel::from_file(&robot_path, &resolver, use_visual)?;
+        let env = RobotModel::from_file(&env_path, &resolver, use_visual)?;
+        Self::from_models(params, robot, env, robot_path.display().to_string(), env_path.display().to_string())
+    }
+
+    /// Builds targets and scene from loaded models (the node's path for `robot_description`).
+    pub fn from_models(params: Params, robot: RobotModel, env: RobotModel, robot_source: String, environment_source: String) -> Result<Checker, CheckerError> {
+        let started = Instant::now();
+        let mut cache = MeshCache::default();
+        let mut summary = BuildSummary { robot_source, environment_source, robot_links: robot.links.len(), ..Default::default() };
+
+        let mut scene = Scene::new();
+        let env_poses = env.forward_kinematics(&vec![0.0; env.joints.len()], &Isometry3::identity());
+        for (li, link) in env.links.iter().enumerate() {
+            for g in &link.geometry {
+                let pose = pose_from_isometry(&(env_poses[li] * g.origin));
+                match &g.spec {
+                    GeometrySpec::Mesh { path, scale } => {
+                        let data = cache.get(path, *scale).map_err(|source| CheckerError::Mesh { link: link.name.clone(), source })?;
+                        let geo = |message: String| CheckerError::Geometry { link: link.name.clone(), path: path.clone(), message };
+                        let mesh = MeshTopology::build(&data.vertices, &data.triangles, &TopologySettings::default()).map_err(|e| geo(e.to_string()))?;
+                        let closed = mesh.report.boundary_edges == 0 && mesh.report.non_manifold_edges == 0;
+                        if closed && params.is_solid_hull(&link.name) {
+                            let hull = ConvexHull::from_points(&data.vertices).ok_or_else(|| geo("its convex hull is flat".into()))?;
+                            let _ = scene.add_solid(link.name.clone(), pose, TargetShape::Polytope(Arc::new(hull)));
+                            summary.solids += 1;
+                        } else {
+                            let (thickness, side) = params.surface_settings(&link.name);
+                            // A closed mesh has an inside: its cells go inward.
+                            let side = if closed { Side::Back } else { side };
+                            let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() }).map_err(|e| geo(e.to_string()))?;
+                            summary.cells += area.cells.len();
+                            let _ = scene.add_surface(link.name.clone(), pose, area);
+                            summary.thin_surfaces += 1;
+                        }
+                    }
+                    spec => {
+                        let shape = primitive_shape(spec, 0.0).ok_or_else(|| CheckerError::Geometry { link: link.name.clone(), path: PathBuf::new(), message: "degenerate primitive".into() })?;
+                        let _ = scene.add_solid(link.name.clone(), pose, shape);
+                        summary.solids += 1;
+                    }
+                }
+            }
+        }
+
+        let mut targets = Vec::new();
+        for (li, link) in robot.links.iter().enumerate() {
+            if link.geometry.is_empty() || !params.is_checked(&link.name) {
+                continue;
+            }
+            let padding = params.padding_of(&link.name);
+            let mut parts = Vec::new();
+            for g in &link.geometry {
+                let shape = match &g.spec {
+                    GeometrySpec::Mesh { path, scale } => {
+                        let data = cache.get(path, *scale).map_err(|source| CheckerError::Mesh { link: link.name.clone(), source })?;
+                        let geo = |message: &str| CheckerError::Geometry { link: link.name.clone(), path: path.clone(), message: message.into() };
+                        let hull = ConvexHull::from_points(&data.vertices).ok_or_else(|| geo("its convex hull is flat or empty"))?;
+                        let hull = hull.padded(padding).ok_or_else(|| geo("padding failed"))?;
+                        TargetShape::Polytope(Arc::new(hull))
+                    }
+                    spec => primitive_shape(spec, padding).ok_or_else(|| CheckerError::Geometry { link: link.name.clone(), path: PathBuf::new(), message: "degenerate primitive".into() })?,
+                };
+                parts.push((shape, pose_from_isometry(&g.origin)));
+            }
+            targets.push(LinkTargets { link: li, name: link.name.clone(), parts });
+        }
+        let allowed = targets
+            .iter()
+            .map(|t| scene.objects().iter().map(|o| params.is_allowed(&t.name, &o.name)).collect())
+            .collect();
+        summary.checked_links = targets.len();
+        summary.meshes_read = cache.meshes.len();
+        summary.build_seconds = started.elapsed().as_secs_f64();
+        let base = base_isometry(&params.robot_base_pose);
+        Ok(Checker { params, robot, targets, scene, summary, base, allowed })
+    }
+
+    /// Checks a joint state. Unknown names are returned for the caller to warn about (or, with
+    /// `strict`, are an error); positions outside limits are flagged in the report.
+    pub fn check_joints(&self, names: &[String], positions: &[f64], memory: &mut JointMemory, strict: bool) -> Result<(StateReport, Vec<String>), StateError> {
+        let started = Instant::now();
+        let (q, unknown) = resolve_positions(&self.robot, names, positions, self.params.missing_joint, memory, strict)?;
+        let poses = self.robot.forward_kinematics(&q, &self.base);
+        let world: Vec<Option<Pose>> = poses.iter().map(|p| Some(pose_from_isometry(p))).collect();
+        let mut report = self.check_link_poses(&world);
+        report.out_of_limits = self
+            .robot
+            .joints
+            .iter()
+            .zip(&q)
+            .filter(|(j, v)| matches!(j.kind, JointKind::Revolute | JointKind::Prismatic) && (**v < j.limits[0] - 1e-12 || **v > j.limits[1] + 1e-12))
+            .map(|(j, _)| j.name.clone())
+            .collect();
+        report.check_seconds = started.elapsed().as_secs_f64();
+        Ok((report, unknown))
+    }
+
+    /// Checks links at given world poses (`/tf` input); links not given are not checked.
+    pub fn check_transforms(&self, transforms: &[(String, Pose)]) -> Result<StateReport, StateError> {
+        let started = Instant::now();
+        let mut world = vec![None; self.robot.links.len()];
+        for (name, pose) in transforms {
+            let li = self.robot.link(name).ok_or_else(|| StateError::UnknownLink(name.clone()))?;
+            let q = pose.rotation;
+            if !pose.translation.is_finite() || !q.is_finite() || (q.length() - 1.0).abs() > 1e-6 {
+                return Err(StateError::BadTransform(name.clone()));
+            }
+            world[li] = Some(Pose::from_parts(pose.translation, q.normalize()));
+        }
+        let mut report = self.check_link_poses(&world);
+        report.check_seconds = started.elapsed().as_secs_f64();
+        Ok(report)
+    }
+
+    /// The deepest contact of every checked link at the given world poses.
+    fn check_link_poses(&self, world: &[Option<Pose>]) -> StateReport {
+        let settings = CollideSettings::default();
+        let mut report = StateReport::default();
+        for (ti, lt) in self.targets.iter().enumerate() {
+            let Some(link_pose) = world[lt.link] else { continue };
+            let mut best: Option<crate::collision::Contact> = None;
+            for (shape, offset) in &lt.parts {
+                let target = Target::new(shape.clone(), link_pose * *offset);
+                let r = self.scene.collide_filtered(&target, &settings, |oi| !self.allowed[ti][oi]);
+                if let Some(c) = r.deepest() {
+                    if best.as_ref().map_or(true, |b| c.depth > b.depth) {
+                        best = Some(*c);
+                    }
+                }
+            }
+            if let Some(c) = best {
+                report.contacts.push(ReportContact {
+                    link_name: lt.name.clone(),
+                    object_name: self.scene.objects()[c.object].name.clone(),
+                    triangle: c.triangle,
+                    depth: c.depth,
+                    position: c.position.to_array(),
+                    normal: c.normal.to_array(),
+                });
+            }
+        }
+        report.in_collision = !report.contacts.is_empty();
+        report
+    }
+}

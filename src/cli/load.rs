@@ -1,0 +1,33 @@
+//! Parameters and overrides to a checker.
+
+use crate::ModelArgs;
+use anyhow::{bail, Result};
+use thickness_collision::checker::Checker;
+use thickness_collision::model::Params;
+
+/// The parameters file (or the defaults) with the command line's overrides applied.
+pub fn params(args: &ModelArgs) -> Result<Params> {
+    let mut params = match &args.params_file {
+        Some(path) => Params::from_file(path)?,
+        None => Params::default(),
+    };
+    if let Some(t) = args.thickness {
+        if !(t > 0.0 && t.is_finite()) {
+            bail!("--thickness must be a positive number of metres, got {t}");
+        }
+        params.default_thickness = t;
+        params.thin_surfaces.thickness.iter_mut().for_each(|x| *x = t);
+    }
+    if let Some(side) = args.side {
+        params.default_side = side.as_str().into();
+        let n = params.thin_surfaces.patterns.len();
+        params.thin_surfaces.side = vec![side.as_str().into(); n];
+    }
+    params.validate()?;
+    Ok(params)
+}
+
+/// Loads the robot and the environment.
+pub fn checker(args: &ModelArgs) -> Result<Checker> {
+    Ok(Checker::from_params(params(args)?, args.robot.as_deref(), args.environment.as_deref())?)
+}

@@ -1,0 +1,5 @@
+//! The subcommands.
+
+pub mod areas;
+pub mod check;
+mod load;

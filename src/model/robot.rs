@@ -1,0 +1,349 @@
+//! A kinematic tree from URDF (`urdf-rs` parses; everything else is here): links with their
+//! collision geometry, joints with limits and mimics, and forward kinematics in `nalgebra` f64.
+
+use super::package::{PackageError, PackageResolver};
+use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// The geometry of one collision (or visual) element, in the link frame after `origin`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GeometrySpec {
+    /// Full sizes (metres).
+    Box([f64; 3]),
+    /// Along local z.
+    Cylinder {
+        /// Radius.
+        radius: f64,
+        /// Full length.
+        length: f64,
+    },
+    /// Along local z.
+    Capsule {
+        /// Radius.
+        radius: f64,
+        /// Length of the segment.
+        length: f64,
+    },
+    /// A ball.
+    Sphere(f64),
+    /// A mesh file (resolved path) and its scale.
+    Mesh {
+        /// Resolved file.
+        path: PathBuf,
+        /// Per-axis scale.
+        scale: [f64; 3],
+    },
+}
+
+/// One geometry element of a link.
+#[derive(Clone, Debug)]
+pub struct LinkGeometry {
+    /// Pose of the geometry in the link frame.
+    pub origin: Isometry3<f64>,
+    /// The shape.
+    pub spec: GeometrySpec,
+}
+
+/// A link.
+#[derive(Clone, Debug)]
+pub struct LinkModel {
+    /// Name.
+    pub name: String,
+    /// Collision geometry (or visual, where configured and collision is absent).
+    pub geometry: Vec<LinkGeometry>,
+}
+
+/// The motion a joint allows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointKind {
+    /// Rotation about the axis, limited.
+    Revolute,
+    /// Rotation about the axis, unlimited.
+    Continuous,
+    /// Translation along the axis.
+    Prismatic,
+    /// No motion.
+    Fixed,
+    /// Six degrees of freedom; placed at its origin (joint states cannot carry it; use `/tf`).
+    Floating,
+    /// Motion in a plane; placed at its origin (as `Floating`).
+    Planar,
+}
+
+/// A mimic relation: `q = multiplier * q[joint] + offset`.
+#[derive(Clone, Copy, Debug)]
+pub struct Mimic {
+    /// Index of the joint followed.
+    pub joint: usize,
+    /// Multiplier.
+    pub multiplier: f64,
+    /// Offset.
+    pub offset: f64,
+}
+
+/// A joint.
+#[derive(Clone, Debug)]
+pub struct JointModel {
+    /// Name.
+    pub name: String,
+    /// Kind.
+    pub kind: JointKind,
+    /// Parent link index.
+    pub parent: usize,
+    /// Child link index.
+    pub child: usize,
+    /// Pose of the joint frame in the parent link frame.
+    pub origin: Isometry3<f64>,
+    /// Unit axis in the joint frame.
+    pub axis: Unit<Vector3<f64>>,
+    /// Lower and upper limits (radians or metres; infinite when absent or continuous).
+    pub limits: [f64; 2],
+    /// Mimic relation, if any.
+    pub mimic: Option<Mimic>,
+}
+
+impl JointModel {
+    /// Whether the joint takes a position from a joint state (not fixed, not a mimic).
+    pub fn is_actuated(&self) -> bool {
+        matches!(self.kind, JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic) && self.mimic.is_none()
+    }
+}
+
+/// A URDF that cannot be used.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// The file cannot be read.
+    #[error("cannot read URDF file {0}")]
+    Io(PathBuf, #[source] std::io::Error),
+    /// urdf-rs rejected the XML.
+    #[error("{file}: malformed URDF: {message}")]
+    Urdf {
+        /// File (or `robot_description`).
+        file: String,
+        /// What urdf-rs said.
+        message: String,
+    },
+    /// A mesh URI of a link does not resolve.
+    #[error("{file}: link '{link}': {source}")]
+    Package {
+        /// File.
+        file: String,
+        /// Link.
+        link: String,
+        /// Why.
+        #[source]
+        source: PackageError,
+    },
+    /// The joints do not form a tree.
+    #[error("{file}: {message}")]
+    Structure {
+        /// File.
+        file: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A number in the URDF is NaN, infinite or out of its domain.
+    #[error("{file}: {what} has an invalid value {value}")]
+    Value {
+        /// File.
+        file: String,
+        /// Where.
+        what: String,
+        /// The value.
+        value: f64,
+    },
+}
+
+/// A robot (or an environment) as a kinematic tree.
+#[derive(Clone, Debug)]
+pub struct RobotModel {
+    /// The robot's name.
+    pub name: String,
+    /// Links.
+    pub links: Vec<LinkModel>,
+    /// Joints.
+    pub joints: Vec<JointModel>,
+    /// The root link.
+    pub root: usize,
+    /// Joints in an order where every joint's parent link is placed before it.
+    order: Vec<usize>,
+    link_index: HashMap<String, usize>,
+    joint_index: HashMap<String, usize>,
+}
+
+fn rpy(v: [f64; 3]) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_euler_angles(v[0], v[1], v[2])
+}
+
+fn isometry(p: &urdf_rs::Pose) -> Isometry3<f64> {
+    Isometry3::from_parts(Translation3::new(p.xyz[0], p.xyz[1], p.xyz[2]), rpy(p.rpy.0))
+}
+
+impl RobotModel {
+    /// Loads a URDF file; relative mesh paths resolve from its folder.
+    pub fn from_file(path: &Path, resolver: &PackageResolver, use_visual: bool) -> Result<RobotModel, ModelError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ModelError::Io(path.to_owned(), e))?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        Self::from_str(&text, &path.display().to_string(), base, resolver, use_visual)
+    }
+
+    /// Parses URDF text (`file` names it in errors; relative paths resolve from `base_dir`).
+    pub fn from_str(text: &str, file: &str, base_dir: &Path, resolver: &PackageResolver, use_visual: bool) -> Result<RobotModel, ModelError> {
+        let urdf = urdf_rs::read_from_string(text).map_err(|e| ModelError::Urdf { file: file.into(), message: e.to_string() })?;
+        let structure = |message: String| ModelError::Structure { file: file.into(), message };
+        if urdf.links.is_empty() {
+            return Err(structure("the robot has no links".into()));
+        }
+        let mut link_index = HashMap::new();
+        let mut links = Vec::with_capacity(urdf.links.len());
+        for (i, l) in urdf.links.iter().enumerate() {
+            if link_index.insert(l.name.clone(), i).is_some() {
+                return Err(structure(format!("link '{}' is defined twice", l.name)));
+            }
+            let elements: Vec<(&urdf_rs::Pose, &urdf_rs::Geometry)> = if l.collision.is_empty() && use_visual {
+                l.visual.iter().map(|v| (&v.origin, &v.geometry)).collect()
+            } else {
+                l.collision.iter().map(|c| (&c.origin, &c.geometry)).collect()
+            };
+            let mut geometry = Vec::new();
+            for (origin, g) in elements {
+                let bad = |what: &str, value: f64| ModelError::Value { file: file.into(), what: format!("link '{}' {what}", l.name), value };
+                for v in origin.xyz.0.iter().chain(origin.rpy.0.iter()) {
+                    if !v.is_finite() {
+                        return Err(bad("origin", *v));
+                    }
+                }
+                let positive = |what: &str, v: f64| if v > 0.0 && v.is_finite() { Ok(v) } else { Err(bad(what, v)) };
+                let spec = match g {
+                    urdf_rs::Geometry::Box { size } => {
+                        GeometrySpec::Box([positive("box size", size[0])?, positive("box size", size[1])?, positive("box size", size[2])?])
+                    }
+                    urdf_rs::Geometry::Cylinder { radius, length } => {
+                        GeometrySpec::Cylinder { radius: positive("cylinder radius", *radius)?, length: positive("cylinder length", *length)? }
+                    }
+                    urdf_rs::Geometry::Capsule { radius, length } => GeometrySpec::Capsule {
+                        radius: positive("capsule radius", *radius)?,
+                        length: if *length >= 0.0 && length.is_finite() { *length } else { return Err(bad("capsule length", *length)) },
+                    },
+                    urdf_rs::Geometry::Sphere { radius } => GeometrySpec::Sphere(positive("sphere radius", *radius)?),
+                    urdf_rs::Geometry::Mesh { filename, scale } => {
+                        let path = resolver.resolve(filename, base_dir).map_err(|source| ModelError::Package { file: file.into(), link: l.name.clone(), source })?;
+                        let scale = scale.map_or([1.0; 3], |s| s.0);
+                        if let Some(s) = scale.iter().find(|s| !(s.is_finite() && **s != 0.0)) {
+                            return Err(bad("mesh scale", *s));
+                        }
+                        GeometrySpec::Mesh { path, scale }
+                    }
+                };
+                geometry.push(LinkGeometry { origin: isometry(origin), spec });
+            }
+            links.push(LinkModel { name: l.name.clone(), geometry });
+        }
+        let mut joint_index = HashMap::new();
+        let mut joints = Vec::with_capacity(urdf.joints.len());
+        let mut parent_of = vec![None; links.len()];
+        for (i, j) in urdf.joints.iter().enumerate() {
+            let find = |name: &str, role: &str| link_index.get(name).copied().ok_or_else(|| structure(format!("joint '{}' names {role} link '{name}', which does not exist", j.name)));
+            let (parent, child) = (find(&j.parent.link, "parent")?, find(&j.child.link, "child")?);
+            if joint_index.insert(j.name.clone(), i).is_some() {
+                return Err(structure(format!("joint '{}' is defined twice", j.name)));
+            }
+            if let Some(other) = parent_of[child].replace(i) {
+                return Err(structure(format!("link '{}' is the child of two joints ('{}' and '{}')", j.child.link, urdf.joints[other].name, j.name)));
+            }
+            let kind = match j.joint_type {
+                urdf_rs::JointType::Revolute => JointKind::Revolute,
+                urdf_rs::JointType::Continuous => JointKind::Continuous,
+                urdf_rs::JointType::Prismatic => JointKind::Prismatic,
+                urdf_rs::JointType::Fixed => JointKind::Fixed,
+                urdf_rs::JointType::Floating | urdf_rs::JointType::Spherical => JointKind::Floating,
+                urdf_rs::JointType::Planar => JointKind::Planar,
+            };
+            let a = Vector3::from(j.axis.xyz.0);
+            let axis = Unit::try_new(a, 1e-12).ok_or_else(|| structure(format!("joint '{}' has a zero or invalid axis {:?}", j.name, j.axis.xyz.0)))?;
+            for v in j.origin.xyz.0.iter().chain(j.origin.rpy.0.iter()) {
+                if !v.is_finite() {
+                    return Err(ModelError::Value { file: file.into(), what: format!("joint '{}' origin", j.name), value: *v });
+                }
+            }
+            let limits = match kind {
+                JointKind::Revolute | JointKind::Prismatic => [j.limit.lower, j.limit.upper],
+                _ => [f64::NEG_INFINITY, f64::INFINITY],
+            };
+            joints.push(JointModel { name: j.name.clone(), kind, parent, child, origin: isometry(&j.origin), axis, limits, mimic: None });
+        }
+        for (i, j) in urdf.joints.iter().enumerate() {
+            if let Some(m) = &j.mimic {
+                let target = *joint_index.get(&m.joint).ok_or_else(|| structure(format!("joint '{}' mimics '{}', which does not exist", j.name, m.joint)))?;
+                joints[i].mimic = Some(Mimic { joint: target, multiplier: m.multiplier.unwrap_or(1.0), offset: m.offset.unwrap_or(0.0) });
+            }
+        }
+        let roots: Vec<usize> = (0..links.len()).filter(|&l| parent_of[l].is_none()).collect();
+        let root = match roots[..] {
+            [r] => r,
+            [] => return Err(structure("the joints form a cycle: no root link".into())),
+            _ => {
+                let names: Vec<&str> = roots.iter().map(|&r| links[r].name.as_str()).collect();
+                return Err(structure(format!("more than one root link: {}", names.join(", "))));
+            }
+        };
+        // Breadth-first from the root: parents before children.
+        let mut children: Vec<Vec<usize>> = vec![Vec::new(); links.len()];
+        for (i, j) in joints.iter().enumerate() {
+            children[j.parent].push(i);
+        }
+        let mut order = Vec::with_capacity(joints.len());
+        let mut queue = std::collections::VecDeque::from([root]);
+        while let Some(l) = queue.pop_front() {
+            for &j in &children[l] {
+                order.push(j);
+                queue.push_back(joints[j].child);
+            }
+        }
+        if order.len() != joints.len() {
+            return Err(structure("the joints form a cycle".into()));
+        }
+        for j in &joints {
+            if let Some(m) = j.mimic {
+                if joints[m.joint].mimic.is_some() {
+                    return Err(structure(format!("joint '{}' mimics '{}', which is itself a mimic", j.name, joints[m.joint].name)));
+                }
+            }
+        }
+        Ok(RobotModel { name: urdf.name, links, joints, root, order, link_index, joint_index })
+    }
+
+    /// Index of a link by name.
+    pub fn link(&self, name: &str) -> Option<usize> {
+        self.link_index.get(name).copied()
+    }
+
+    /// Index of a joint by name.
+    pub fn joint(&self, name: &str) -> Option<usize> {
+        self.joint_index.get(name).copied()
+    }
+
+    /// The world pose of every link, given a position for every joint (indexed like `joints`;
+    /// ignored for fixed, floating and planar joints and for mimics, whose value is derived) and
+    /// the pose of the root link in the world.
+    pub fn forward_kinematics(&self, positions: &[f64], base: &Isometry3<f64>) -> Vec<Isometry3<f64>> {
+        let mut poses = vec![Isometry3::identity(); self.links.len()];
+        poses[self.root] = *base;
+        for &ji in &self.order {
+            let j = &self.joints[ji];
+            let q = match j.mimic {
+                Some(m) => m.multiplier * positions[m.joint] + m.offset,
+                None => positions[ji],
+            };
+            let motion = match j.kind {
+                JointKind::Revolute | JointKind::Continuous => Isometry3::from_parts(Translation3::identity(), UnitQuaternion::from_axis_angle(&j.axis, q)),
+                JointKind::Prismatic => Isometry3::from_parts(Translation3::from(j.axis.into_inner() * q), UnitQuaternion::identity()),
+                JointKind::Fixed | JointKind::Floating | JointKind::Planar => Isometry3::identity(),
+            };
+            poses[j.child] = poses[j.parent] * j.origin * motion;
+        }
+        poses
+    }
+}
