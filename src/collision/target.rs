@@ -2,6 +2,7 @@
 
 use crate::math::{Aabb, Pose, Real, Vector};
 use parry3d_f64::shape::ConvexPolyhedron;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// One face of a hull: outward unit normal and the hull's extent along it.
@@ -66,46 +67,44 @@ impl ConvexHull {
         let points = parry.points().to_vec();
         let (lo, hi) = points.iter().fold((Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
         let centroid = points.iter().copied().sum::<Vector>() / points.len() as Real;
+        // Faces and edges from the face polygons (parry merges coplanar triangles). Edge-to-face
+        // links are rebuilt here from the polygons rather than taken from parry's `Edge::faces`,
+        // which pointed past the face list on a 524-face hull of a Solo12 mesh.
         let adj = parry.vertices_adj_to_face();
-        let faces: Vec<HullFace> = parry
-            .faces()
-            .iter()
-            .map(|f| {
-                let on_face = points[adj[f.first_vertex_or_edge as usize] as usize];
-                let min = points.iter().map(|p| f.normal.dot(*p)).fold(Real::INFINITY, Real::min);
-                HullFace { normal: f.normal, max: f.normal.dot(on_face), min }
-            })
-            .collect();
-        let edges = parry
-            .edges()
-            .iter()
-            .map(|e| HullEdge {
-                point: points[e.vertices[0] as usize],
-                dir: (points[e.vertices[1] as usize] - points[e.vertices[0] as usize]).normalize(),
-                n1: faces[e.faces[0] as usize].normal,
-                n2: faces[e.faces[1] as usize].normal,
-            })
-            .collect();
-        if faces.len() < 4 || !centroid.is_finite() {
+        let mut faces: Vec<HullFace> = Vec::with_capacity(parry.faces().len());
+        let mut edge_faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+        for (fi, f) in parry.faces().iter().enumerate() {
+            let verts = &adj[f.first_vertex_or_edge as usize..(f.first_vertex_or_edge + f.num_vertices_or_edges) as usize];
+            let on_face = points[*verts.first()? as usize];
+            let min = points.iter().map(|p| f.normal.dot(*p)).fold(Real::INFINITY, Real::min);
+            faces.push(HullFace { normal: f.normal, max: f.normal.dot(on_face), min });
+            for k in 0..verts.len() {
+                let (a, b) = (verts[k], verts[(k + 1) % verts.len()]);
+                edge_faces.entry((a.min(b), a.max(b))).or_default().push(fi);
+            }
+        }
+        let mut edges = Vec::with_capacity(edge_faces.len());
+        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); points.len()];
+        let mut keys: Vec<(u32, u32)> = edge_faces.keys().copied().collect();
+        keys.sort_unstable();
+        for (a, b) in keys {
+            let fs = &edge_faces[&(a, b)];
+            if fs.len() != 2 {
+                return None; // not a closed polytope
+            }
+            let (pa, pb) = (points[a as usize], points[b as usize]);
+            edges.push(HullEdge { point: pa, dir: (pb - pa).normalize(), n1: faces[fs[0]].normal, n2: faces[fs[1]].normal });
+            neighbours[a as usize].push(b);
+            neighbours[b as usize].push(a);
+        }
+        if faces.len() < 4 || !centroid.is_finite() || edges.iter().any(|e| !e.dir.is_finite()) {
             return None;
         }
-        let mut degree = vec![0u32; points.len() + 1];
-        for e in parry.edges() {
-            degree[e.vertices[0] as usize] += 1;
-            degree[e.vertices[1] as usize] += 1;
-        }
         let mut adjacency_first = vec![0u32; points.len() + 1];
-        for i in 0..points.len() {
-            adjacency_first[i + 1] = adjacency_first[i] + degree[i];
-        }
-        let mut fill = adjacency_first.clone();
-        let mut adjacency = vec![0u32; adjacency_first[points.len()] as usize];
-        for e in parry.edges() {
-            let [a, b] = e.vertices;
-            adjacency[fill[a as usize] as usize] = b;
-            fill[a as usize] += 1;
-            adjacency[fill[b as usize] as usize] = a;
-            fill[b as usize] += 1;
+        let mut adjacency = Vec::new();
+        for (i, n) in neighbours.iter().enumerate() {
+            adjacency.extend_from_slice(n);
+            adjacency_first[i + 1] = adjacency.len() as u32;
         }
         let mut extreme = [0u32; 6];
         for (k, dir) in [Vector::X, -Vector::X, Vector::Y, -Vector::Y, Vector::Z, -Vector::Z].into_iter().enumerate() {

@@ -262,7 +262,14 @@ impl RobotModel {
                 urdf_rs::JointType::Planar => JointKind::Planar,
             };
             let a = Vector3::from(j.axis.xyz.0);
-            let axis = Unit::try_new(a, 1e-12).ok_or_else(|| structure(format!("joint '{}' has a zero or invalid axis {:?}", j.name, j.axis.xyz.0)))?;
+            // Only moving joints need an axis; fixed joints in real URDFs (Talos) carry `0 0 0`.
+            let axis = match Unit::try_new(a, 1e-12) {
+                Some(axis) if a.iter().all(|v| v.is_finite()) => axis,
+                _ if matches!(kind, JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic) => {
+                    return Err(structure(format!("joint '{}' has a zero or invalid axis {:?}", j.name, j.axis.xyz.0)));
+                }
+                _ => Vector3::z_axis(),
+            };
             for v in j.origin.xyz.0.iter().chain(j.origin.rpy.0.iter()) {
                 if !v.is_finite() {
                     return Err(ModelError::Value { file: file.into(), what: format!("joint '{}' origin", j.name), value: *v });
