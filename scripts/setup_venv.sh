@@ -4,7 +4,7 @@
 set -euo pipefail
 venv="${TC_VENV:-$HOME/.cache/thickness_collision/venv}"
 # Pinned peers (see ../shared/design.md, "Real peers for tests").
-packages=(numpy "coal==3.0.3")
+packages=(numpy "coal==3.0.3" "example-robot-data==6.0.0" "yourdfpy==0.0.60")
 stamp="$venv/.tc-packages"
 want="${packages[*]}"
 if [ -x "$venv/bin/python" ] && [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then

@@ -1,0 +1,129 @@
+//! The `check` command on the bundled workcell: JSON lines, the same answer from every input
+//! form, and every kind of bad input as a one-line error naming it, with exit code 2.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tc_cli_check_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn ok(out: Output) -> String {
+    assert!(out.status.success(), "failed: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn err(out: Output, needles: &[&str]) {
+    assert_eq!(out.status.code(), Some(2), "expected exit 2; stderr: {}", String::from_utf8_lossy(&out.stderr));
+    let e = String::from_utf8(out.stderr).unwrap();
+    let last = e.trim_end().lines().last().unwrap_or("").to_owned();
+    for n in needles {
+        assert!(last.contains(n), "error should name {n:?}: {last}");
+    }
+}
+
+const COLLIDING: &str = "shoulder_pan_joint=0,shoulder_lift_joint=1.2,elbow_joint=0.3";
+
+#[test]
+fn json_lines_agree_across_input_forms_and_runs() {
+    let joints = ok(bin().args(["check", "--joints", COLLIDING, "--json"]).output().unwrap());
+    let v: serde_json::Value = serde_json::from_str(joints.trim()).unwrap();
+    assert_eq!(v["in_collision"], true);
+    let c = &v["contacts"][0];
+    for field in ["link_name", "object_name", "triangle", "depth", "position", "normal"] {
+        assert!(!c[field].is_null(), "contact lacks {field}");
+    }
+    assert_eq!(c["object_name"], "guard_sheet");
+
+    // The same state in a states file, after a clear one and an unknown joint (a warning only).
+    let states = tmp("states.jsonl");
+    std::fs::write(
+        &states,
+        concat!(
+            r#"{"name": ["shoulder_pan_joint", "other_robot_joint"], "position": [0.0, 1.0]}"#, "\n",
+            r#"{"name": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"], "position": [0, 1.2, 0.3]}"#, "\n",
+        ),
+    )
+    .unwrap();
+    let run = || bin().args(["check", "--states", states.to_str().unwrap(), "--json"]).output().unwrap();
+    let first = run();
+    let stderr = String::from_utf8_lossy(&first.stderr).to_string();
+    assert!(stderr.contains("'other_robot_joint' is not a joint"), "{stderr}");
+    let lines = ok(first);
+    let lines: Vec<&str> = lines.lines().collect();
+    assert_eq!(lines.len(), 2);
+    assert_eq!(serde_json::from_str::<serde_json::Value>(lines[0]).unwrap()["in_collision"], false);
+    assert_eq!(lines[1], joints.trim(), "the same state gives the same bytes");
+    assert_eq!(ok(run()), ok(run()), "deterministic");
+
+    // Human-readable output names the link and the object.
+    let text = ok(bin().args(["check", "--joints", COLLIDING]).output().unwrap());
+    assert!(text.contains("IN COLLISION") && text.contains("forearm_link x guard_sheet"), "{text}");
+}
+
+#[test]
+fn out_of_limits_is_flagged() {
+    let out = ok(bin().args(["check", "--joints", "elbow_joint=3.0", "--json"]).output().unwrap());
+    let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    assert_eq!(v["out_of_limits"], serde_json::json!(["elbow_joint"]));
+}
+
+#[test]
+fn thickness_and_side_override_the_parameters() {
+    // The wrist ball (r = 5 cm) placed with its nearest point 1 to 3 cm behind the corrugated
+    // guard sheet (surface between x = 0.54 and 0.56, front towards -x).
+    let states = tmp("behind.jsonl");
+    std::fs::write(&states, r#"{"transforms": [{"link": "wrist_1_link", "translation": [0.62, 0.0, 0.4], "rotation": [0, 0, 0, 1]}]}"#).unwrap();
+    let hit = |extra: &[&str]| -> bool {
+        let out = ok(bin().args(["check", "--states", states.to_str().unwrap(), "--json"]).args(extra).output().unwrap());
+        serde_json::from_str::<serde_json::Value>(out.trim()).unwrap()["in_collision"].as_bool().unwrap()
+    };
+    assert!(hit(&[]), "default 2 cm reaches it");
+    assert!(hit(&["--thickness", "0.2"]));
+    assert!(!hit(&["--thickness", "0.005"]), "5 mm does not");
+    assert!(!hit(&["--side", "front"]), "front cells lie on the other side");
+    assert!(hit(&["--side", "both"]));
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    // Malformed XML.
+    let bad_xml = tmp("bad.urdf");
+    std::fs::write(&bad_xml, "<robot name='x'><link name='a'></robot>").unwrap();
+    err(bin().args(["check", "--robot", bad_xml.to_str().unwrap(), "--joints", "a=0"]).output().unwrap(), &["bad.urdf", "malformed"]);
+    // Unknown package.
+    let pkg = tmp("pkg.urdf");
+    std::fs::write(&pkg, r#"<robot name="x"><link name="a"><collision><geometry><mesh filename="package://no_such_pkg/m.stl"/></geometry></collision></link></robot>"#).unwrap();
+    err(bin().args(["check", "--robot", pkg.to_str().unwrap(), "--joints", "a=0"]).env("AMENT_PREFIX_PATH", "/nonexistent_prefix").env_remove("ROS_PACKAGE_PATH").output().unwrap(), &["package://no_such_pkg/m.stl", "'no_such_pkg'", "/nonexistent_prefix/share/no_such_pkg"]);
+    // Missing mesh file.
+    let missing = tmp("missing.urdf");
+    std::fs::write(&missing, r#"<robot name="x"><link name="a"><collision><geometry><mesh filename="nowhere.stl"/></geometry></collision></link></robot>"#).unwrap();
+    err(bin().args(["check", "--robot", missing.to_str().unwrap(), "--joints", "a=0"]).output().unwrap(), &["link 'a'", "nowhere.stl"]);
+    // A mesh with NaN.
+    std::fs::write(tmp("nan.obj"), "v 0 0 0\nv 1 nan 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n").unwrap();
+    let nan = tmp("nan.urdf");
+    std::fs::write(&nan, r#"<robot name="x"><link name="a"><collision><geometry><mesh filename="nan.obj"/></geometry></collision></link></robot>"#).unwrap();
+    err(bin().args(["check", "--robot", nan.to_str().unwrap(), "--joints", "a=0"]).output().unwrap(), &["link 'a'", "nan.obj", "non-finite"]);
+    // Unknown parameter key.
+    let params = tmp("params.yaml");
+    std::fs::write(&params, "thickness_collision:\n  ros__parameters:\n    default_thicknes: 0.01\n").unwrap();
+    err(bin().args(["check", "--params-file", params.to_str().unwrap(), "--joints", "elbow_joint=0"]).output().unwrap(), &["params.yaml", "default_thicknes"]);
+    // A joint name in --joints not in the model, and a NaN position.
+    err(bin().args(["check", "--joints", "elbow_jiont=0.1"]).output().unwrap(), &["--joints", "'elbow_jiont'"]);
+    err(bin().args(["check", "--joints", "elbow_joint=nan"]).output().unwrap(), &["elbow_joint", "non-finite"]);
+    // A JSON line that is not a state, and unequal lengths.
+    let states = tmp("bad.jsonl");
+    std::fs::write(&states, "{\"name\": [\"elbow_joint\"], \"position\": [0.1]}\n{\"hello\": 1}\n").unwrap();
+    err(bin().args(["check", "--states", states.to_str().unwrap()]).output().unwrap(), &["bad.jsonl", "line 2", "not a state"]);
+    std::fs::write(&states, "{\"name\": [\"elbow_joint\"], \"position\": [0.1, 0.2]}\n").unwrap();
+    err(bin().args(["check", "--states", states.to_str().unwrap()]).output().unwrap(), &["line 1", "1 names but 2 positions"]);
+    // missing_joint: reject.
+    std::fs::write(&params, "thickness_collision:\n  ros__parameters:\n    missing_joint: reject\n").unwrap();
+    err(bin().args(["check", "--params-file", params.to_str().unwrap(), "--joints", "elbow_joint=0"]).output().unwrap(), &["lacks joint"]);
+}

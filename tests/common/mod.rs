@@ -1,0 +1,40 @@
+//! Shared by the integration tests that talk to the Python peers (coal, yourdfpy, rosbags, ...).
+#![allow(dead_code)]
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+
+/// The peers' interpreter: `$TC_PYTHON`, set by `.ci/run` (`scripts/setup_venv.sh`). A missing
+/// peer is a failure, never a skip.
+pub fn python() -> PathBuf {
+    match std::env::var_os("TC_PYTHON") {
+        Some(p) => PathBuf::from(p),
+        None => panic!("TC_PYTHON is not set: run the tests with `bash .ci/run` (it installs the Python peers)"),
+    }
+}
+
+/// Runs a peer script from `tests/peers/` with a JSON request on stdin; returns its JSON answer.
+pub fn run_peer(script: &str, request: &serde_json::Value) -> serde_json::Value {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers").join(script);
+    let mut child = Command::new(python()).arg(&path).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("start the Python peer");
+    child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "{script} failed: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{script} answered no JSON: {e}"))
+}
+
+/// `<site-packages>/cmeel.prefix/share/example-robot-data`, where example-robot-data installs.
+pub fn example_robot_data() -> PathBuf {
+    let out = Command::new(python()).args(["-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"]).output().unwrap();
+    let site = String::from_utf8(out.stdout).unwrap();
+    let dir = PathBuf::from(site.trim()).join("cmeel.prefix/share/example-robot-data");
+    assert!(dir.is_dir(), "example-robot-data is not installed in the peers' venv ({})", dir.display());
+    dir
+}
+
+/// The robot URDF at `rel` inside example-robot-data, with the package map that resolves it.
+pub fn erd_robot(rel: &str) -> (PathBuf, Vec<String>) {
+    let root = example_robot_data();
+    (root.join("robots").join(rel), vec![format!("example-robot-data={}", root.display())])
+}
