@@ -15,4 +15,5 @@ pub mod collision;
 pub mod math;
 pub mod mesh;
 pub mod model;
+pub mod msgs;
 pub mod thickness;

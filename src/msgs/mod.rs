@@ -1,0 +1,173 @@
+//! ROS 2 message types as serde structs (CDR via `cdr-encoding`), shared by the node and the bag
+//! replay, and their `.msg` definitions (the MCAP `ros2msg` schemas).
+//!
+//! Field order is wire order: CDR has no field names. The project's own messages mirror
+//! `interfaces/thickness_collision_msgs/msg/*.msg`; `tests/msgs_cdr.rs` checks both against
+//! rosbags' serializer.
+
+mod cdr;
+mod definitions;
+
+pub use self::cdr::{decode_cdr, encode_cdr_le, CdrError};
+pub use self::definitions::{full_definition, COLLISION_REPORT_TYPE};
+
+use serde::{Deserialize, Serialize};
+
+/// `builtin_interfaces/msg/Time`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct Time {
+    /// Seconds.
+    pub sec: i32,
+    /// Nanoseconds.
+    pub nanosec: u32,
+}
+
+impl Time {
+    /// From nanoseconds since the epoch.
+    pub fn from_nanos(ns: i64) -> Time {
+        Time { sec: ns.div_euclid(1_000_000_000) as i32, nanosec: ns.rem_euclid(1_000_000_000) as u32 }
+    }
+
+    /// Nanoseconds since the epoch.
+    pub fn as_nanos(&self) -> i64 {
+        self.sec as i64 * 1_000_000_000 + self.nanosec as i64
+    }
+}
+
+/// `std_msgs/msg/Header`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// Stamp.
+    pub stamp: Time,
+    /// Frame.
+    pub frame_id: String,
+}
+
+/// `std_msgs/msg/String`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StringMsg {
+    /// Text.
+    pub data: String,
+}
+
+/// `sensor_msgs/msg/JointState`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct JointState {
+    /// Header.
+    pub header: Header,
+    /// Joint names.
+    pub name: Vec<String>,
+    /// Positions (radians or metres).
+    pub position: Vec<f64>,
+    /// Velocities.
+    pub velocity: Vec<f64>,
+    /// Efforts.
+    pub effort: Vec<f64>,
+}
+
+/// `geometry_msgs/msg/Vector3`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Vector3 {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+}
+
+/// `geometry_msgs/msg/Point`.
+pub type Point = Vector3;
+
+/// `geometry_msgs/msg/Quaternion`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Quaternion {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+    /// w.
+    pub w: f64,
+}
+
+impl Default for Quaternion {
+    fn default() -> Self {
+        Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 }
+    }
+}
+
+/// `geometry_msgs/msg/Transform`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Transform {
+    /// Translation.
+    pub translation: Vector3,
+    /// Rotation.
+    pub rotation: Quaternion,
+}
+
+/// `geometry_msgs/msg/TransformStamped`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TransformStamped {
+    /// Header (`frame_id` is the parent frame).
+    pub header: Header,
+    /// The child frame.
+    pub child_frame_id: String,
+    /// Pose of the child in the parent.
+    pub transform: Transform,
+}
+
+/// `tf2_msgs/msg/TFMessage`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TfMessage {
+    /// Transforms.
+    pub transforms: Vec<TransformStamped>,
+}
+
+/// `thickness_collision_msgs/msg/Contact`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Contact {
+    /// Robot link.
+    pub link_name: String,
+    /// Environment object.
+    pub object_name: String,
+    /// Triangle in the object's mesh file (4294967295 for solids).
+    pub triangle: u32,
+    /// How far the link reaches past the surface along `normal` (metres).
+    pub depth: f64,
+    /// A point within 1e-6 m of both shapes.
+    pub position: Point,
+    /// Push-out direction.
+    pub normal: Vector3,
+}
+
+/// `thickness_collision_msgs/msg/CollisionReport`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CollisionReport {
+    /// The input's stamp and `world_frame`.
+    pub header: Header,
+    /// Whether any checked link collides.
+    pub in_collision: bool,
+    /// At least one contact (the deepest) for every colliding link.
+    pub contacts: Vec<Contact>,
+    /// Time spent checking (seconds).
+    pub check_seconds: f64,
+}
+
+impl CollisionReport {
+    /// The message for a checker's report.
+    pub fn from_state(report: &crate::checker::StateReport, header: Header) -> CollisionReport {
+        let v = |a: [f64; 3]| Vector3 { x: a[0], y: a[1], z: a[2] };
+        CollisionReport {
+            header,
+            in_collision: report.in_collision,
+            contacts: report
+                .contacts
+                .iter()
+                .map(|c| Contact { link_name: c.link_name.clone(), object_name: c.object_name.clone(), triangle: c.triangle, depth: c.depth, position: v(c.position), normal: v(c.normal) })
+                .collect(),
+            check_seconds: report.check_seconds,
+        }
+    }
+}
