@@ -16,4 +16,5 @@ pub mod math;
 pub mod mesh;
 pub mod model;
 pub mod msgs;
+pub mod replay;
 pub mod thickness;

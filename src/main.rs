@@ -52,6 +52,31 @@ enum Command {
         #[arg(long)]
         show_params: bool,
     },
+    /// Replay a recorded rosbag2 bag (MCAP or sqlite3) through the checker.
+    Replay {
+        /// A rosbag2 directory (with metadata.yaml), an .mcap file or a .db3 file.
+        bag: PathBuf,
+        #[command(flatten)]
+        model: ModelArgs,
+        /// Input topic (default /joint_states, or /tf with --pose-source tf).
+        #[arg(long)]
+        topic: Option<String>,
+        /// Where robot states come from.
+        #[arg(long, value_enum, default_value_t = thickness_collision::replay::PoseSource::JointStates)]
+        pose_source: thickness_collision::replay::PoseSource,
+        /// Write a rosbag2 bag (metadata.yaml + .mcap) with the `collisions` topic here.
+        #[arg(long = "out")]
+        out_dir: Option<PathBuf>,
+        /// Write one JSON report per state here (the objects of `check --json`).
+        #[arg(long)]
+        jsonl: Option<PathBuf>,
+        /// Seconds after the bag's first message to start at.
+        #[arg(long)]
+        start: Option<f64>,
+        /// Seconds after the bag's first message to stop at.
+        #[arg(long)]
+        end: Option<f64>,
+    },
 }
 
 /// Where the robot, the environment and the thin-surface settings come from (shared by
@@ -90,6 +115,10 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Areas { mesh, thickness, side, scale, json } => cli::areas::areas(mesh, thickness, side, &scale, json),
         Command::Check { model, joints, states, json, show_params } => cli::check::check(&model, joints.as_deref(), states.as_deref(), json, show_params),
+        Command::Replay { bag, model, topic, pose_source, out_dir, jsonl, start, end } => {
+            let opts = thickness_collision::replay::ReplayOptions { bag, topic, pose_source, out_dir, jsonl, start, end, progress: true };
+            cli::replay::replay(&model, &opts)
+        }
     }
 }
 

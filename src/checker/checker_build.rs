@@ -156,6 +156,21 @@ impl Checker {
         Self::from_models(params, robot, env, robot_path.display().to_string(), env_path.display().to_string())
     }
 
+    /// As [`Checker::from_params`], but with the robot from URDF text (a `robot_description`
+    /// message); `source` names it in errors. Mesh paths must be `package://`, `file://` or
+    /// absolute.
+    pub fn from_description(params: Params, description: &str, source: &str, environment: Option<&Path>) -> Result<Checker, CheckerError> {
+        params.validate()?;
+        let resolver = PackageResolver::new(&params.package_map);
+        let env_path = environment.map(Path::to_owned).unwrap_or_else(|| {
+            if params.environment_file.is_empty() { bundled_config_dir().join("example_workcell/environment.urdf") } else { PathBuf::from(&params.environment_file) }
+        });
+        let use_visual = params.use_visual_when_no_collision;
+        let robot = RobotModel::from_str(description, source, Path::new("."), &resolver, use_visual)?;
+        let env = RobotModel::from_file(&env_path, &resolver, use_visual)?;
+        Self::from_models(params, robot, env, source.to_owned(), env_path.display().to_string())
+    }
+
     /// Builds targets and scene from loaded models (the node's path for `robot_description`).
     pub fn from_models(params: Params, robot: RobotModel, env: RobotModel, robot_source: String, environment_source: String) -> Result<Checker, CheckerError> {
         let started = Instant::now();

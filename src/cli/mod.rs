@@ -2,4 +2,5 @@
 
 pub mod areas;
 pub mod check;
+pub mod replay;
 mod load;

@@ -1,0 +1,12 @@
+//! Replay of recorded rosbag2 bags (MCAP or sqlite3) through the same pipeline as the node:
+//! joint states (or `/tf`) in, one collision report per state out, as JSON lines and/or as a new
+//! rosbag2 bag with the `collisions` topic.
+
+mod bag_reader;
+mod bag_writer;
+mod replay_run;
+mod tf_tree;
+
+pub use self::bag_reader::{open_bag, BagError, BagMessage, BagReader};
+pub use self::bag_writer::BagWriter;
+pub use self::replay_run::{replay, PoseSource, ReplayOptions, ReplaySummary};

@@ -1,0 +1,48 @@
+//! The latest transform of every frame from `/tf` and `/tf_static`, and world poses from them.
+
+use crate::math::{Pose, Rotation, Vector};
+use crate::msgs::TfMessage;
+use std::collections::HashMap;
+
+/// Child frame to (parent frame, pose in parent).
+#[derive(Default)]
+pub struct TfTree {
+    edges: HashMap<String, (String, Pose)>,
+}
+
+impl TfTree {
+    /// Records every transform of a message; returns the child frames that were not finite.
+    pub fn update(&mut self, msg: &TfMessage) -> Vec<String> {
+        let mut bad = Vec::new();
+        for t in &msg.transforms {
+            let (tr, q) = (t.transform.translation, t.transform.rotation);
+            let rot = Rotation::from_xyzw(q.x, q.y, q.z, q.w);
+            let v = Vector::new(tr.x, tr.y, tr.z);
+            if !v.is_finite() || !rot.is_finite() || (rot.length() - 1.0).abs() > 1e-6 {
+                bad.push(t.child_frame_id.clone());
+                continue;
+            }
+            let _ = self.edges.insert(strip(&t.child_frame_id).to_owned(), (strip(&t.header.frame_id).to_owned(), Pose::from_parts(v, rot.normalize())));
+        }
+        bad
+    }
+
+    /// The pose of `frame` in `world`, if the chain of parents reaches it (at most 256 steps).
+    pub fn world_pose(&self, frame: &str, world: &str) -> Option<Pose> {
+        let mut pose = Pose::IDENTITY;
+        let mut at = frame;
+        for _ in 0..256 {
+            if at == world {
+                return Some(pose);
+            }
+            let (parent, p) = self.edges.get(at)?;
+            pose = *p * pose;
+            at = parent;
+        }
+        None
+    }
+}
+
+fn strip(frame: &str) -> &str {
+    frame.trim_start_matches('/')
+}
