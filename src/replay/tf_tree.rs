@@ -22,15 +22,21 @@ impl TfTree {
                 bad.push(t.child_frame_id.clone());
                 continue;
             }
-            let _ = self.edges.insert(strip(&t.child_frame_id).to_owned(), (strip(&t.header.frame_id).to_owned(), Pose::from_parts(v, rot.normalize())));
+            let _ = self.edges.insert(strip(&t.child_frame_id).to_owned(), (strip(&t.header.frame_id).to_owned(), Pose::from_parts(v, rot)));
         }
         bad
     }
 
     /// The pose of `frame` in `world`, if the chain of parents reaches it (at most 256 steps).
     pub fn world_pose(&self, frame: &str, world: &str) -> Option<Pose> {
-        let mut pose = Pose::IDENTITY;
-        let mut at = frame;
+        if frame == world {
+            return Some(Pose::IDENTITY);
+        }
+        // Composed from the frame up; the first edge is taken as is, so a transform given
+        // directly in the world frame reaches the checker bit for bit.
+        let (parent, first) = self.edges.get(frame)?;
+        let mut pose = *first;
+        let mut at = parent.as_str();
         for _ in 0..256 {
             if at == world {
                 return Some(pose);
