@@ -5,6 +5,7 @@ use super::report::{CollideSettings, Contact, TargetReport};
 use super::target::{Target, TargetShape};
 use crate::math::{Aabb, Pose, Real, Vector};
 use crate::thickness::ThicknessArea;
+use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 
 /// What an environment object is made of.
@@ -127,6 +128,11 @@ impl Scene {
             let (area, bvh) = match &object.body {
                 ObjectBody::Surface { area, bvh } => (area, bvh),
                 ObjectBody::Solid(shape) => {
+                    // Bounding boxes first: GJK costs ~2 us, and most links are nowhere near.
+                    let target_in_object = object.pose.inv_mul(&target.pose);
+                    if !target.aabb_in(&target_in_object).intersects(&shape.local_aabb()) {
+                        continue;
+                    }
                     report.candidates += 1;
                     if let Some(contact) = collide_solid(target, oi, &object.pose, shape) {
                         report.objects.push(oi);
@@ -205,9 +211,9 @@ impl Scene {
 /// A target against a convex solid, with parry's GJK/EPA: the depth is the penetration depth, the
 /// normal the direction that pushes the target out, the point midway between the two witnesses.
 fn collide_solid(target: &Target, object: usize, object_pose: &Pose, shape: &TargetShape) -> Option<Contact> {
-    let (s1, o1) = target.shape.to_parry();
-    let (s2, o2) = shape.to_parry();
-    let c = parry3d_f64::query::contact(&(target.pose * o1), &*s1, &(*object_pose * o2), &*s2, 0.0).ok().flatten()?;
+    let c = target.shape.with_parry(|s1, o1| {
+        shape.with_parry(|s2, o2| parry3d_f64::query::contact(&(target.pose * *o1), s1, &(*object_pose * *o2), s2, 0.0).ok().flatten())
+    })?;
     if !(c.dist < 0.0) {
         return None;
     }

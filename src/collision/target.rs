@@ -259,17 +259,18 @@ impl TargetShape {
         }
     }
 
-    /// The same shape for parry's GJK/EPA queries, with its pose in this shape's frame (parry's
-    /// cylinders run along `y`).
-    pub fn to_parry(&self) -> (Box<dyn parry3d_f64::shape::Shape>, Pose) {
+    /// Calls `f` with the same shape for parry's GJK/EPA queries and its pose in this shape's
+    /// frame (parry's cylinders run along `y`). Hulls are lent, not cloned: a clone of a
+    /// 100-vertex polyhedron cost more than the query.
+    pub fn with_parry<R>(&self, f: impl FnOnce(&dyn parry3d_f64::shape::Shape, &Pose) -> R) -> R {
         use parry3d_f64::shape::{Ball, Capsule, Cylinder};
         match self {
-            TargetShape::Polytope(h) => (Box::new(h.as_parry().clone()), Pose::IDENTITY),
-            TargetShape::Sphere { radius } => (Box::new(Ball::new(*radius)), Pose::IDENTITY),
-            TargetShape::Capsule { half_height, radius } => (Box::new(Capsule::new_z(*half_height, *radius)), Pose::IDENTITY),
-            TargetShape::Cylinder { half_height, radius } => (
-                Box::new(Cylinder::new(*half_height, *radius)),
-                Pose::from_rotation(crate::math::Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2)),
+            TargetShape::Polytope(h) => f(h.as_parry(), &Pose::IDENTITY),
+            TargetShape::Sphere { radius } => f(&Ball::new(*radius), &Pose::IDENTITY),
+            TargetShape::Capsule { half_height, radius } => f(&Capsule::new_z(*half_height, *radius), &Pose::IDENTITY),
+            TargetShape::Cylinder { half_height, radius } => f(
+                &Cylinder::new(*half_height, *radius),
+                &Pose::from_rotation(crate::math::Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2)),
             ),
         }
     }

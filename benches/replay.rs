@@ -1,0 +1,80 @@
+//! Replay rate on a 100,000-state bag of the bundled workcell, I/O included (reading the MCAP,
+//! decoding CDR, checking, writing JSON lines and an output bag). Prints a table.
+//!
+//! `cargo bench --bench replay`
+
+use mcap::records::MessageHeader;
+use oorandom::Rand64;
+use std::collections::BTreeMap;
+use std::io::BufWriter;
+use std::path::Path;
+use std::time::Instant;
+use thickness_collision::checker::Checker;
+use thickness_collision::model::Params;
+use thickness_collision::msgs::{encode_cdr_le, Header, JointState, Time};
+use thickness_collision::replay::{replay, PoseSource, ReplayOptions};
+
+const STATES: usize = 100_000;
+
+fn write_bag(dir: &Path, states: &[(Vec<String>, Vec<f64>)]) {
+    std::fs::create_dir_all(dir).unwrap();
+    let file = std::fs::File::create(dir.join("bench_0.mcap")).unwrap();
+    let mut w = mcap::WriteOptions::new().profile("ros2").create(BufWriter::new(file)).unwrap();
+    let def = "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n";
+    let schema = w.add_schema("sensor_msgs/msg/JointState", "ros2msg", def.as_bytes()).unwrap();
+    let ch = w.add_channel(schema, "/joint_states", "cdr", &BTreeMap::new()).unwrap();
+    let t0: i64 = 1_700_000_000_000_000_000;
+    for (k, (name, position)) in states.iter().enumerate() {
+        let t = t0 + k as i64 * 1_000_000;
+        let msg = JointState { header: Header { stamp: Time::from_nanos(t), frame_id: String::new() }, name: name.clone(), position: position.clone(), velocity: vec![], effort: vec![] };
+        w.write_to_known_channel(&MessageHeader { channel_id: ch, sequence: k as u32, log_time: t as u64, publish_time: t as u64 }, &encode_cdr_le(&msg)).unwrap();
+    }
+    let _ = w.finish().unwrap();
+    std::fs::write(
+        dir.join("metadata.yaml"),
+        format!("rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths:\n    - bench_0.mcap\n  message_count: {}\n", states.len()),
+    )
+    .unwrap();
+}
+
+fn main() {
+    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let mut rng = Rand64::new(42);
+    let states: Vec<(Vec<String>, Vec<f64>)> = (0..STATES)
+        .map(|_| {
+            let joints: Vec<_> = checker.robot.joints.iter().filter(|j| j.is_actuated()).collect();
+            let names = joints.iter().map(|j| j.name.clone()).collect();
+            let pos = joints.iter().map(|j| { let (lo, hi) = (j.limits[0].max(-3.0), j.limits[1].min(3.0)); lo + (hi - lo) * rng.rand_float() }).collect();
+            (names, pos)
+        })
+        .collect();
+    let root = std::env::temp_dir().join(format!("tc_bench_replay_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let bag = root.join("in");
+    write_bag(&bag, &states);
+    let size = std::fs::metadata(bag.join("bench_0.mcap")).unwrap().len();
+
+    println!("replay of {STATES} joint states of the bundled arm against the bundled workcell ({:.1} MB MCAP)", size as f64 / 1e6);
+    println!("{:<44} {:>10} {:>12} {:>12}", "outputs", "seconds", "states/s", "us/state");
+    for (label, jsonl, out) in [("summary only", false, false), ("JSON lines", true, false), ("JSON lines + output bag", true, true)] {
+        let opts = ReplayOptions {
+            bag: bag.clone(),
+            topic: None,
+            pose_source: PoseSource::JointStates,
+            out_dir: out.then(|| root.join(format!("out_{}", label.len()))),
+            jsonl: jsonl.then(|| root.join("out.jsonl")),
+            start: None,
+            end: None,
+            progress: false,
+        };
+        let started = Instant::now();
+        let summary = replay(Params::default(), None, None, &opts).unwrap();
+        let secs = started.elapsed().as_secs_f64();
+        assert_eq!(summary.states, STATES);
+        println!("{label:<44} {secs:>10.3} {:>12.0} {:>12.2}", STATES as f64 / secs, secs / STATES as f64 * 1e6);
+        if label == "summary only" {
+            println!("  ({} of {STATES} states in collision)", summary.in_collision);
+        }
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
