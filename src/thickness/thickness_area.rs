@@ -3,6 +3,7 @@
 use super::thickness_cell::{CellKind, Side, ThicknessCell};
 use crate::math::{intersect_three_planes, Real, Vector};
 use crate::mesh::{EdgeLink, MeshTopology, TopologyReport};
+use rustc_hash::FxHashSet;
 use serde::Serialize;
 
 /// Which side walls the cells get.
@@ -114,6 +115,8 @@ impl ThicknessArea {
             ..ThicknessReport::default()
         };
         let fold_cos = settings.fold_angle.cos();
+        // Every face on a non-manifold edge sees it; count each edge once (by its vertex pair).
+        let mut non_manifold: FxHashSet<(u32, u32)> = FxHashSet::default();
         let mut cells = Vec::with_capacity(mesh.triangles.len());
         for f in 0..mesh.triangles.len() {
             let p = mesh.corners(f);
@@ -123,7 +126,10 @@ impl ThicknessArea {
                 let mut m = n;
                 match mesh.links[f][i] {
                     EdgeLink::Boundary => report.boundary_edges += 1,
-                    EdgeLink::NonManifold => report.non_manifold_edges += 1,
+                    EdgeLink::NonManifold => {
+                        let (a, b) = (mesh.triangles[f][i], mesh.triangles[f][(i + 1) % 3]);
+                        let _ = non_manifold.insert((a.min(b), a.max(b)));
+                    }
                     EdgeLink::Shared { face, consistent } => {
                         let first = (f as u32) < face;
                         let ng = mesh.normals[face as usize];
@@ -159,6 +165,7 @@ impl ThicknessArea {
                 None => report.degenerate_skipped += 1,
             }
         }
+        report.non_manifold_edges = non_manifold.len();
         report.cells = cells.len();
         Ok(ThicknessArea { cells, thickness: t, side: settings.side, report })
     }
