@@ -171,6 +171,35 @@ impl Checker {
         Self::from_models(params, robot, env, source.to_owned(), env_path.display().to_string())
     }
 
+    /// A checker for `robot` against a scene built elsewhere (benchmarks, generated worlds).
+    pub fn from_robot_and_scene(params: Params, robot: RobotModel, scene: Scene, robot_source: String) -> Result<Checker, CheckerError> {
+        let empty = RobotModel::from_str("<robot name=\"empty\"><link name=\"world\"/></robot>", "empty", Path::new("."), &PackageResolver::default(), false)?;
+        let mut checker = Self::from_models(params, robot, empty, robot_source, "generated scene".into())?;
+        checker.summary.thin_surfaces = scene.objects().iter().filter(|o| o.area().is_some()).count();
+        checker.summary.cells = scene.cell_count();
+        checker.allowed = checker.targets.iter().map(|t| scene.objects().iter().map(|o| checker.params.is_allowed(&t.name, &o.name)).collect()).collect();
+        checker.scene = scene;
+        Ok(checker)
+    }
+
+    /// Checks many joint states at once, each on its own (`missing_joint: last` sees no earlier
+    /// state), on all cores with the `parallel` feature. Reports come back in input order.
+    pub fn check_joints_batch(&self, states: &[(Vec<String>, Vec<f64>)]) -> Vec<Result<StateReport, StateError>> {
+        let one = |(names, positions): &(Vec<String>, Vec<f64>)| {
+            let mut memory = JointMemory::new(&self.robot);
+            self.check_joints(names, positions, &mut memory, false).map(|(r, _)| r)
+        };
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            states.par_iter().map(one).collect()
+        }
+        #[cfg(not(feature = "parallel"))]
+        {
+            states.iter().map(one).collect()
+        }
+    }
+
     /// Builds targets and scene from loaded models (the node's path for `robot_description`).
     pub fn from_models(params: Params, robot: RobotModel, env: RobotModel, robot_source: String, environment_source: String) -> Result<Checker, CheckerError> {
         let started = Instant::now();
