@@ -78,11 +78,11 @@ impl<'a> LocalPair<'a> {
 /// (target frame) and the depth the pair reports if it collides: the claim's `Bmax - Amin` on that
 /// axis. `pos12` is the pose of the cell's object in the target's frame.
 #[inline]
-pub(crate) fn normal_axis(target: &Target, cell: &ThicknessCell, side: Side, pos12: &Pose) -> Option<(Vector, Real)> {
+pub(crate) fn normal_axis(target: &Target, cell: &ThicknessCell, side: Side, pos12: &Pose, hint: &mut [u32; 2]) -> Option<(Vector, Real)> {
     let n = pos12.rotation * cell.normal;
     let shift = n.dot(pos12.translation);
     let [b_min, b_max] = cell.normal_range().map(|x| x + shift);
-    let [a_min, a_max] = target.shape.project(n);
+    let [a_min, a_max] = target.shape.project_hinted(n, hint);
     if a_max <= b_min || b_max <= a_min || !(a_min.is_finite() && a_max.is_finite()) {
         return None;
     }
@@ -115,7 +115,7 @@ pub(crate) fn normal_axis(target: &Target, cell: &ThicknessCell, side: Side, pos
 /// ```
 pub fn collide_target_cell(target: &Target, cell: &ThicknessCell, side: Side, object_pose: &Pose, want_point: bool) -> Option<CellHit> {
     let pos12 = target.pose.inv_mul(object_pose);
-    let (push, depth) = normal_axis(target, cell, side, &pos12)?;
+    let (push, depth) = normal_axis(target, cell, side, &pos12, &mut [u32::MAX; 2])?;
     let pair = LocalPair::new(target, cell, &pos12);
     let sat = pair.sat()?;
     let rot = target.pose.rotation;

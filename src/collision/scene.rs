@@ -154,9 +154,10 @@ impl Scene {
             let aabb = target.aabb_in(&target_in_object);
             let side = area.side;
             survivors.clear();
+            let mut hint = [u32::MAX; 2];
             for leaf in bvh.intersect_aabb(&aabb) {
                 report.candidates += 1;
-                if let Some((push, depth)) = normal_axis(target, &area.cells[leaf as usize], side, &object_in_target) {
+                if let Some((push, depth)) = normal_axis(target, &area.cells[leaf as usize], side, &object_in_target, &mut hint) {
                     survivors.push((depth, leaf, push));
                 }
             }

@@ -170,10 +170,20 @@ impl ConvexHull {
     /// neighbour improves on is the global maximum. Starts at the extreme vertex of the closest
     /// coordinate axis; on a ~100-vertex link hull that visits ~5 vertices instead of 100.
     fn climb(&self, dir: Vector) -> Real {
-        let a = dir.abs();
-        let k = if a.x >= a.y && a.x >= a.z { 0 } else if a.y >= a.z { 2 } else { 4 };
-        let k = k + (dir[k / 2] < 0.0) as usize;
-        let mut at = self.extreme[k] as usize;
+        self.climb_from(dir, u32::MAX).0
+    }
+
+    /// Hill climbing from vertex `start` (`u32::MAX`: the extreme vertex of the closest axis);
+    /// returns the maximum and the vertex where it is reached, the start for a nearby direction.
+    fn climb_from(&self, dir: Vector, start: u32) -> (Real, u32) {
+        let mut at = if (start as usize) < self.points.len() {
+            start as usize
+        } else {
+            let a = dir.abs();
+            let k = if a.x >= a.y && a.x >= a.z { 0 } else if a.y >= a.z { 2 } else { 4 };
+            let k = k + (dir[k / 2] < 0.0) as usize;
+            self.extreme[k] as usize
+        };
         let mut best = dir.dot(self.points[at]);
         loop {
             let mut moved = false;
@@ -187,7 +197,7 @@ impl ConvexHull {
                 }
             }
             if !moved {
-                return best;
+                return (best, at as u32);
             }
         }
     }
@@ -236,6 +246,22 @@ impl TargetShape {
                 let h = Vector::new(*radius, *radius, half_height + extra);
                 Aabb::new(-h, h)
             }
+        }
+    }
+
+    /// As [`TargetShape::project`], starting the hill climbs of a hull at the vertices of the
+    /// previous call (`hint`, `[u32::MAX; 2]` at first): the cells a query visits have similar
+    /// normals, and a warm start takes a climb from ~15 steps to ~2 on a Panda link.
+    #[inline]
+    pub(crate) fn project_hinted(&self, dir: Vector, hint: &mut [u32; 2]) -> [Real; 2] {
+        match self {
+            TargetShape::Polytope(h) if h.points.len() >= CLIMB_MIN_POINTS => {
+                let (hi, at_hi) = h.climb_from(dir, hint[0]);
+                let (lo, at_lo) = h.climb_from(-dir, hint[1]);
+                *hint = [at_hi, at_lo];
+                [-lo, hi]
+            }
+            _ => self.project(dir),
         }
     }
 
