@@ -30,6 +30,17 @@ pub struct SceneObject {
     pub pose: Pose,
     /// Its geometry.
     pub body: ObjectBody,
+    /// Its bounding box in the world (a first, cheap reject per target).
+    world_aabb: Aabb,
+}
+
+/// The world box of a box given in a frame posed at `pose`.
+fn transformed_aabb(local: &Aabb, pose: &Pose) -> Aabb {
+    let c = *pose * local.center();
+    let h = local.half_extents();
+    let m = parry3d_f64::math::Matrix::from_quat(pose.rotation);
+    let e = Vector::new(m.row(0).abs().dot(h), m.row(1).abs().dot(h), m.row(2).abs().dot(h));
+    Aabb::new(c - e, c + e)
 }
 
 impl SceneObject {
@@ -74,13 +85,15 @@ impl Scene {
     pub fn add_surface(&mut self, name: impl Into<String>, pose: Pose, area: ThicknessArea) -> usize {
         let aabbs: Vec<Aabb> = area.cells.iter().map(cell_aabb).collect();
         let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs);
-        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Surface { area, bvh } });
+        let world_aabb = if aabbs.is_empty() { Aabb::new_invalid() } else { transformed_aabb(&bvh.root_aabb(), &pose) };
+        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Surface { area, bvh }, world_aabb });
         self.objects.len() - 1
     }
 
     /// Adds a convex solid placed at `pose` in the world. Returns the object's index.
     pub fn add_solid(&mut self, name: impl Into<String>, pose: Pose, shape: TargetShape) -> usize {
-        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Solid(shape) });
+        let world_aabb = transformed_aabb(&shape.local_aabb(), &pose);
+        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Solid(shape), world_aabb });
         self.objects.len() - 1
     }
 
@@ -121,8 +134,9 @@ impl Scene {
         let mut deepest: Option<Contact> = None;
         // Candidates that the normal axis does not separate: (depth if colliding, cell index).
         let mut survivors: Vec<(Real, u32, Vector)> = Vec::new();
+        let target_aabb = target.aabb_in(&target.pose);
         for (oi, object) in self.objects.iter().enumerate() {
-            if !check(oi) {
+            if !check(oi) || !object.world_aabb.intersects(&target_aabb) {
                 continue;
             }
             let (area, bvh) = match &object.body {
