@@ -21,6 +21,19 @@ pub fn try_normalize(v: Vector, min_len: Real) -> Option<Vector> {
     }
 }
 
+/// `[min, max]` of `dir . p` over `points` (the projection of a point set on an axis).
+#[inline]
+pub fn project_points(points: &[Vector], dir: Vector) -> [Real; 2] {
+    let mut lo = Real::INFINITY;
+    let mut hi = Real::NEG_INFINITY;
+    for p in points {
+        let d = dir.dot(*p);
+        lo = lo.min(d);
+        hi = hi.max(d);
+    }
+    [lo, hi]
+}
+
 /// Solves `[n0; n1; n2] x = [d0, d1, d2]` (three planes `n_i . x = d_i`) by Cramer's rule.
 ///
 /// Returns `None` when the normals are linearly dependent relative to their lengths

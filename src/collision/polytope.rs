@@ -64,14 +64,7 @@ impl CellPolytope {
     /// `[min, max]` of `dir . x` over the cell.
     #[inline]
     pub fn project(&self, dir: Vector) -> [Real; 2] {
-        let mut lo = Real::INFINITY;
-        let mut hi = Real::NEG_INFINITY;
-        for v in &self.verts {
-            let d = dir.dot(*v);
-            lo = lo.min(d);
-            hi = hi.max(d);
-        }
-        [lo, hi]
+        crate::math::project_points(&self.verts, dir)
     }
 
     /// The edges that exist (collapsed caps have none).

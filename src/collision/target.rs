@@ -154,14 +154,7 @@ impl ConvexHull {
         if self.points.len() >= CLIMB_MIN_POINTS {
             return [-self.climb(-dir), self.climb(dir)];
         }
-        let mut lo = Real::INFINITY;
-        let mut hi = Real::NEG_INFINITY;
-        for p in &self.points {
-            let d = dir.dot(*p);
-            lo = lo.min(d);
-            hi = hi.max(d);
-        }
-        [lo, hi]
+        crate::math::project_points(&self.points, dir)
     }
 }
 
