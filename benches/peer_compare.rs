@@ -28,8 +28,8 @@ fn main() {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
 
     let mut table = String::new();
-    let _ = writeln!(table, "| triangles | cells | build (s) | memory (MiB) | colliding states (ours / coal) | ours µs/state | batch µs/state ({cores} cores) | coal µs/state | FCL µs/state | ours/coal | ours/FCL | explained (thickness / touching) | unexplained |");
-    let _ = writeln!(table, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(table, "| triangles | cells | build (s) | memory (MiB) | colliding states (ours / coal) | ours µs/state | batch µs/state ({cores} cores) | ours flag-only µs/state | coal µs/state | FCL µs/state | ours/coal | ours/FCL | flag-only/coal | explained (thickness / touching) | unexplained |");
+    let _ = writeln!(table, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     let mut points = Vec::new();
     let mut unexplained_total = 0;
     for &size in &sizes {
@@ -39,9 +39,9 @@ fn main() {
         let (ours, coal, fcl) = (per(c.ours_seconds), per(c.coal_seconds), per(c.fcl_seconds));
         let _ = writeln!(
             table,
-            "| {} | {} | {:.3} | {:.1} | {} / {} ({:.0} %) | {ours:.2} | {:.2} | {coal:.2} | {fcl:.2} | {:.2} | {:.2} | {} / {} | {} |",
+            "| {} | {} | {:.3} | {:.1} | {} / {} ({:.0} %) | {ours:.2} | {:.2} | {:.2} | {coal:.2} | {fcl:.2} | {:.2} | {:.2} | {:.2} | {} / {} | {} |",
             c.triangles, c.cells, c.build_seconds, c.memory_bytes as f64 / 1048576.0, c.ours_colliding_states, c.coal_colliding_states,
-            100.0 * c.ours_colliding_states as f64 / c.states as f64, per(c.batch_seconds), ours / coal, ours / fcl, c.explained_thickness, c.explained_touching, c.unexplained.len()
+            100.0 * c.ours_colliding_states as f64 / c.states as f64, per(c.batch_seconds), per(c.flags_seconds), ours / coal, ours / fcl, per(c.flags_seconds) / coal, c.explained_thickness, c.explained_touching, c.unexplained.len()
         );
         for u in c.unexplained.iter().take(20) {
             eprintln!("UNEXPLAINED {u}");

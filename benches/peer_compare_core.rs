@@ -92,6 +92,7 @@ pub struct Comparison {
     pub memory_bytes: usize,
     pub states: usize,
     pub ours_seconds: f64,
+    pub flags_seconds: f64,
     pub batch_seconds: f64,
     pub coal_seconds: f64,
     pub fcl_seconds: f64,
@@ -117,6 +118,15 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
         reports.push(checker.check_joints(names, pos, &mut memory, true).unwrap().0);
     }
     let ours_seconds = started.elapsed().as_secs_f64();
+    // Like for like with the peers' boolean collide: which links collide, first cell wins.
+    let started = Instant::now();
+    for ((names, pos), full) in states.iter().zip(&reports) {
+        let mut memory = JointMemory::new(&checker.robot);
+        let flags = checker.check_joints_flags(names, pos, &mut memory).unwrap();
+        let (a, b): (Vec<&str>, Vec<&str>) = (flags.contacts.iter().map(|c| c.link_name.as_str()).collect(), full.contacts.iter().map(|c| c.link_name.as_str()).collect());
+        assert_eq!(a, b, "flag-only and full checks must agree on the colliding links");
+    }
+    let flags_seconds = started.elapsed().as_secs_f64();
     let started = Instant::now();
     let batch = checker.check_joints_batch(states);
     let batch_seconds = started.elapsed().as_secs_f64();
@@ -188,6 +198,7 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
         memory_bytes,
         states: states.len(),
         ours_seconds,
+        flags_seconds,
         batch_seconds,
         coal_seconds: peers["coal"]["seconds"].as_f64().unwrap(),
         fcl_seconds: peers["fcl"]["seconds"].as_f64().unwrap(),

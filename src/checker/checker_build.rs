@@ -276,11 +276,22 @@ impl Checker {
     /// Checks a joint state. Unknown names are returned for the caller to warn about (or, with
     /// `strict`, are an error); positions outside limits are flagged in the report.
     pub fn check_joints(&self, names: &[String], positions: &[f64], memory: &mut JointMemory, strict: bool) -> Result<(StateReport, Vec<String>), StateError> {
+        self.check_joints_with(names, positions, memory, strict, &CollideSettings::default())
+    }
+
+    /// Which links collide, and nothing more: each link stops at its first colliding cell, and
+    /// its contact carries only link and object names (NaN depth, point and normal). The
+    /// like-for-like counterpart of a boolean `collide` in FCL or coal.
+    pub fn check_joints_flags(&self, names: &[String], positions: &[f64], memory: &mut JointMemory) -> Result<StateReport, StateError> {
+        self.check_joints_with(names, positions, memory, false, &CollideSettings { flag_only: true, ..Default::default() }).map(|(r, _)| r)
+    }
+
+    fn check_joints_with(&self, names: &[String], positions: &[f64], memory: &mut JointMemory, strict: bool, settings: &CollideSettings) -> Result<(StateReport, Vec<String>), StateError> {
         let started = Instant::now();
         let (q, unknown) = resolve_positions(&self.robot, names, positions, self.params.missing_joint, memory, strict)?;
         let poses = self.robot.forward_kinematics(&q, &self.base);
         let world: Vec<Option<Pose>> = poses.iter().map(|p| Some(pose_from_isometry(p))).collect();
-        let mut report = self.check_link_poses(&world);
+        let mut report = self.check_link_poses(&world, settings);
         report.out_of_limits = self
             .robot
             .joints
@@ -305,21 +316,27 @@ impl Checker {
             }
             world[li] = Some(Pose::from_parts(pose.translation, q.normalize()));
         }
-        let mut report = self.check_link_poses(&world);
+        let mut report = self.check_link_poses(&world, &CollideSettings::default());
         report.check_seconds = started.elapsed().as_secs_f64();
         Ok(report)
     }
 
     /// The deepest contact of every checked link at the given world poses.
-    fn check_link_poses(&self, world: &[Option<Pose>]) -> StateReport {
-        let settings = CollideSettings::default();
+    fn check_link_poses(&self, world: &[Option<Pose>], settings: &CollideSettings) -> StateReport {
         let mut report = StateReport::default();
         for (ti, lt) in self.targets.iter().enumerate() {
             let Some(link_pose) = world[lt.link] else { continue };
             let mut best: Option<crate::collision::Contact> = None;
             for (shape, offset) in &lt.parts {
                 let target = Target::new(shape.clone(), link_pose * *offset);
-                let r = self.scene.collide_filtered(&target, &settings, |oi| !self.allowed[ti][oi]);
+                let r = self.scene.collide_filtered(&target, settings, |oi| !self.allowed[ti][oi]);
+                if settings.flag_only {
+                    if let Some(c) = r.contacts.first() {
+                        best = Some(*c);
+                        break;
+                    }
+                    continue;
+                }
                 if let Some(c) = r.deepest() {
                     if best.as_ref().map_or(true, |b| c.depth > b.depth) {
                         best = Some(*c);

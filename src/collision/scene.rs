@@ -172,6 +172,17 @@ impl Scene {
             for leaf in bvh.intersect_aabb(&aabb) {
                 report.candidates += 1;
                 if let Some((push, depth)) = normal_axis(target, &area.cells[leaf as usize], side, &object_in_target, &mut hint) {
+                    if settings.flag_only {
+                        // A yes/no question: the first cell that collides answers it.
+                        let cell = &area.cells[leaf as usize];
+                        if let Some(sat) = LocalPair::new(target, cell, &object_in_target).sat() {
+                            let nan = Vector::splat(Real::NAN);
+                            report.objects.push(oi);
+                            report.contacts.push(Contact { object: oi, triangle: cell.triangle, depth, normal: target.pose.rotation * push, position: nan, overlap: sat.overlap, axis: target.pose.rotation * sat.axis });
+                            return report;
+                        }
+                        continue;
+                    }
                     survivors.push((depth, leaf, push));
                 }
             }
@@ -188,11 +199,6 @@ impl Scene {
                 let Some(sat) = pair.sat() else { continue };
                 hit_object = true;
                 let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: nan, overlap: sat.overlap, axis: rot * sat.axis };
-                if settings.flag_only {
-                    report.objects.push(oi);
-                    report.contacts.push(contact);
-                    return report;
-                }
                 if settings.all_contacts {
                     contact.position = pair.point(push).map_or(nan, |p| target.pose * p);
                     report.contacts.push(contact);
