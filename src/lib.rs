@@ -17,4 +17,6 @@ pub mod mesh;
 pub mod model;
 pub mod msgs;
 pub mod replay;
+#[cfg(feature = "ros")]
+pub mod ros;
 pub mod thickness;

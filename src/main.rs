@@ -52,6 +52,15 @@ enum Command {
         #[arg(long)]
         show_params: bool,
     },
+    /// Run the ROS 2 node (on the bundled workcell by default).
+    #[cfg(feature = "ros")]
+    Run {
+        #[command(flatten)]
+        model: ModelArgs,
+        /// ROS arguments: `--ros-args -r __ns:=/robot1 -r __node:=name -p key:=value --params-file F`.
+        #[arg(long = "ros-args", num_args = 0.., allow_hyphen_values = true)]
+        ros_args: Vec<String>,
+    },
     /// Replay a recorded rosbag2 bag (MCAP or sqlite3) through the checker.
     Replay {
         /// A rosbag2 directory (with metadata.yaml), an .mcap file or a .db3 file.
@@ -115,6 +124,8 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Areas { mesh, thickness, side, scale, json } => cli::areas::areas(mesh, thickness, side, &scale, json),
         Command::Check { model, joints, states, json, show_params } => cli::check::check(&model, joints.as_deref(), states.as_deref(), json, show_params),
+        #[cfg(feature = "ros")]
+        Command::Run { model, ros_args } => cli::run::run(&model, &ros_args),
         Command::Replay { bag, model, topic, pose_source, out_dir, jsonl, start, end } => {
             let opts = thickness_collision::replay::ReplayOptions { bag, topic, pose_source, out_dir, jsonl, start, end, progress: true };
             cli::replay::replay(&model, &opts)

@@ -1,0 +1,13 @@
+//! The ROS 2 node: `joint_states` in, `collisions` out, and the `check_states` service, over
+//! ros2-client (RustDDS). Nothing here does geometry: states go to [`crate::checker::Checker`].
+//!
+//! DDS stays where the environment says: `ROS_DOMAIN_ID`, and `ROS_AUTOMATIC_DISCOVERY_RANGE=
+//! LOCALHOST` or `ROS_LOCALHOST_ONLY=1` bind the participant to 127.0.0.1 (ros2-client ignores
+//! these variables itself, so the participant is built here).
+
+mod msg_impls;
+mod node_run;
+mod ros_args;
+
+pub use self::node_run::{run, RunOptions};
+pub use self::ros_args::{parse_ros_args, RosArgs};

@@ -1,0 +1,25 @@
+//! The shared message types are ROS messages for ros2-client.
+
+use crate::msgs::{CollisionReport, JointState, StringMsg, TfMessage};
+use serde::{Deserialize, Serialize};
+
+impl ros2_client::Message for JointState {}
+impl ros2_client::Message for CollisionReport {}
+impl ros2_client::Message for TfMessage {}
+impl ros2_client::Message for StringMsg {}
+
+/// `thickness_collision_msgs/srv/CheckStates` request.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct CheckStatesRequest {
+    /// The states to check.
+    pub states: Vec<JointState>,
+}
+impl ros2_client::Message for CheckStatesRequest {}
+
+/// `thickness_collision_msgs/srv/CheckStates` response.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct CheckStatesResponse {
+    /// One report per state, in order.
+    pub reports: Vec<CollisionReport>,
+}
+impl ros2_client::Message for CheckStatesResponse {}

@@ -1,0 +1,134 @@
+"""An independent ROS 2 participant (Cyclone DDS from Python) for tests/ros_node.rs.
+
+Publishes sensor_msgs/JointState on rt/joint_states, reads rt/collisions with types built from the
+project's own .msg files, and calls the check_states service (Cyclone's request/reply mapping).
+Loopback only: the caller sets CYCLONEDDS_URI (127.0.0.1, no multicast, peer 127.0.0.1).
+
+stdin: {"domain": id, "states": [{"name": [...], "position": [...], "stamp": ns}], "bad": [...],
+        "service_states": [...], "timeout": s}
+stdout: {"reports": [...], "service": [...]}
+"""
+import json
+import sys
+import time
+import types
+from dataclasses import dataclass
+from pathlib import Path
+
+from cyclonedds.core import Policy, Qos
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.idl import IdlStruct
+from cyclonedds.idl import types as t
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def struct_typed(ros_type, fields):
+    """An IDL struct named as ROS 2 names DDS types: pkg::msg::dds_::Type_."""
+    pkg, kind, name = ros_type.split("/")
+    cls = types.new_class(name, (IdlStruct,), {"typename": f"{pkg}::{kind}::dds_::{name}_"},
+                          lambda ns: ns.update({"__annotations__": dict(fields)}))
+    return dataclass(cls)
+
+
+Time = struct_typed("builtin_interfaces/msg/Time", [("sec", t.int32), ("nanosec", t.uint32)])
+Header = struct_typed("std_msgs/msg/Header", [("stamp", Time), ("frame_id", str)])
+Point = struct_typed("geometry_msgs/msg/Point", [("x", t.float64), ("y", t.float64), ("z", t.float64)])
+Vector3 = struct_typed("geometry_msgs/msg/Vector3", [("x", t.float64), ("y", t.float64), ("z", t.float64)])
+JointState = struct_typed("sensor_msgs/msg/JointState", [("header", Header), ("name", t.sequence[str]), ("position", t.sequence[t.float64]),
+                                                         ("velocity", t.sequence[t.float64]), ("effort", t.sequence[t.float64])])
+KNOWN = {"std_msgs/Header": Header, "geometry_msgs/Point": Point, "geometry_msgs/Vector3": Vector3, "sensor_msgs/JointState": JointState}
+PRIMS = {"string": str, "bool": bool, "uint32": t.uint32, "int32": t.int32, "float64": t.float64}
+
+
+def from_msg(pkg, kind, name, text, local):
+    """A Cyclone IDL struct from a .msg definition (the project's own files)."""
+    fields = []
+    for line in text.splitlines():
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        ty, fname = line.split()[:2]
+        seq = ty.endswith("[]")
+        ty = ty[:-2] if seq else ty
+        py = PRIMS.get(ty) or KNOWN.get(ty) or local.get(ty)
+        if py is None:
+            raise ValueError(f"{name}.msg: unknown type {ty}")
+        fields.append((fname, t.sequence[py] if seq else py))
+    return struct_typed(f"{pkg}/{kind}/{name}", fields)
+
+
+IFACE = ROOT / "interfaces" / "thickness_collision_msgs"
+local = {}
+local["Contact"] = from_msg("thickness_collision_msgs", "msg", "Contact", (IFACE / "msg/Contact.msg").read_text(), local)
+local["CollisionReport"] = from_msg("thickness_collision_msgs", "msg", "CollisionReport", (IFACE / "msg/CollisionReport.msg").read_text(), local)
+CollisionReport = local["CollisionReport"]
+req_text, resp_text = (IFACE / "srv/CheckStates.srv").read_text().split("---")
+# Cyclone's request/reply mapping puts a (guid, seq) header before the fields.
+ReqBody = from_msg("thickness_collision_msgs", "srv", "CheckStates_Request", req_text, local)
+RespBody = from_msg("thickness_collision_msgs", "srv", "CheckStates_Response", resp_text, local)
+Request = struct_typed("thickness_collision_msgs/srv/CheckStates_Request", [("guid", t.uint64), ("seq", t.int64), ("states", t.sequence[JointState])])
+Response = struct_typed("thickness_collision_msgs/srv/CheckStates_Response", [("guid", t.uint64), ("seq", t.int64), ("reports", t.sequence[CollisionReport])])
+
+
+def js(s):
+    ns = int(s.get("stamp", 0))
+    return JointState(header=Header(stamp=Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000), frame_id=""),
+                      name=s["name"], position=[float(x) for x in s["position"]], velocity=[], effort=[])
+
+
+def report_json(r):
+    return {"in_collision": bool(r.in_collision), "stamp": r.header.stamp.sec * 1_000_000_000 + r.header.stamp.nanosec, "frame_id": r.header.frame_id,
+            "contacts": [{"link_name": c.link_name, "object_name": c.object_name, "triangle": int(c.triangle), "depth": c.depth,
+                          "position": [c.position.x, c.position.y, c.position.z], "normal": [c.normal.x, c.normal.y, c.normal.z]} for c in r.contacts],
+            "check_seconds": r.check_seconds}
+
+
+req = json.load(sys.stdin)
+dp = DomainParticipant(req["domain"])
+reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(1000))
+best_effort = Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(1))
+writer = DataWriter(dp, Topic(dp, "rt/joint_states", JointState), qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(10)))
+reader = DataReader(dp, Topic(dp, "rt/collisions", CollisionReport), qos=reliable)
+deadline = time.time() + req.get("timeout", 30)
+# Wait for the node's reader and writer to match ours.
+while (writer.get_matched_subscriptions() == [] or reader.get_matched_publications() == []) and time.time() < deadline:
+    time.sleep(0.05)
+out = {"matched": writer.get_matched_subscriptions() != [], "reports": [], "service": []}
+
+
+def collect(n, wait):
+    end = time.time() + wait
+    got = []
+    while len(got) < n and time.time() < end:
+        for s in reader.take(N=100):
+            got.append(report_json(s))
+        time.sleep(0.005)
+    return got
+
+
+for bad in req.get("bad", []):
+    writer.write(js(bad))
+    time.sleep(0.02)
+collect(10 ** 9, 0.3)  # whatever the bad ones produced is not counted
+for s in req["states"]:
+    writer.write(js(s))
+    got = collect(1, 5)
+    out["reports"].extend(got)
+if req.get("service_states"):
+    rq_w = DataWriter(dp, Topic(dp, "rq/check_statesRequest", Request), qos=reliable)
+    rr_r = DataReader(dp, Topic(dp, "rr/check_statesReply", Response), qos=reliable)
+    while (rq_w.get_matched_subscriptions() == [] or rr_r.get_matched_publications() == []) and time.time() < deadline:
+        time.sleep(0.05)
+    rq_w.write(Request(guid=0x1234567890ABCDEF, seq=1, states=[js(s) for s in req["service_states"]]))
+    end = time.time() + 10
+    while not out["service"] and time.time() < end:
+        for r in rr_r.take(N=10):
+            out["service"] = [report_json(x) for x in r.reports]
+            out["service_seq"] = int(r.seq)
+        time.sleep(0.01)
+json.dump(out, sys.stdout)

@@ -1,0 +1,127 @@
+//! The node against an independent ROS 2 participant: Cyclone DDS from Python publishes
+//! `sensor_msgs/JointState` on `rt/joint_states`, reads `rt/collisions` with types built from the
+//! project's own `.msg` files, and calls `check_states` (Cyclone's request/reply mapping). The
+//! reports equal `check --json` on the same states. Loopback only: the node gets
+//! `ROS_LOCALHOST_ONLY=1` and `ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`, Cyclone a config with
+//! `NetworkInterface 127.0.0.1`, no multicast and the peer 127.0.0.1.
+
+mod common;
+
+use serde_json::{json, Value};
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+
+const CYCLONE_LOOPBACK: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers><Peer address="127.0.0.1"/></Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>"#;
+
+fn state(k: usize) -> (Vec<&'static str>, Vec<f64>) {
+    let names = vec!["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
+    let x = k as f64;
+    let pos = vec![(0.37 * x).sin() * 1.5, 0.3 + (0.23 * x).cos() * 1.1, (0.11 * x).sin() * 1.6, 0.2 * x % 3.0, (0.5 * x).cos() * 1.5, 0.1 * x, 0.02];
+    (names, pos)
+}
+
+#[test]
+fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
+    let dir = std::env::temp_dir().join(format!("tc_ros_node_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cyclone = dir.join("cyclone.xml");
+    std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
+    let domain = 100 + std::process::id() % 100;
+    let params = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/params.yaml");
+
+    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+        .args(["run", "--ros-args", "-r", "__node:=tc_test", "--params-file", params.to_str().unwrap()])
+        .env("ROS_DOMAIN_ID", domain.to_string())
+        .env("ROS_LOCALHOST_ONLY", "1")
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(node.stdout.take().unwrap());
+    let mut banner = String::new();
+    while !banner.contains("serves") {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
+        banner += &line;
+    }
+    assert!(banner.contains("/tc_test") && banner.contains("loopback only"), "{banner}");
+
+    // The states, and check's answer for them.
+    let states: Vec<(Vec<&str>, Vec<f64>)> = (0..25).map(state).collect();
+    let lines: Vec<String> = states.iter().map(|(n, p)| json!({"name": n, "position": p}).to_string()).collect();
+    let file = dir.join("states.jsonl");
+    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
+    let reference = Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--params-file", params.to_str().unwrap(), "--states", file.to_str().unwrap(), "--json"]).output().unwrap();
+    assert!(reference.status.success());
+    let reference: Vec<Value> = String::from_utf8(reference.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert!(reference.iter().any(|r| r["in_collision"] == true) && reference.iter().any(|r| r["in_collision"] == false));
+
+    let big: Vec<String> = (0..100_000).map(|i| format!("j{i}")).collect();
+    let bad = json!([
+        {"name": ["elbow_joint"], "position": [f64::NAN.to_string()]},
+        {"name": ["elbow_joint", "wrist_1_joint"], "position": [0.1]},
+        {"name": big, "position": vec![0.0; 100_000]},
+        {"name": ["another_robots_joint"], "position": [1.0]},
+    ]);
+    let request = json!({
+        "domain": domain,
+        "bad": bad,
+        "states": states.iter().enumerate().map(|(k, (n, p))| json!({"name": n, "position": p, "stamp": 1_000_000_000 + k})).collect::<Vec<_>>(),
+        "service_states": states[..5].iter().map(|(n, p)| json!({"name": n, "position": p})).collect::<Vec<_>>(),
+        "timeout": 30,
+    });
+    let answer = {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
+        let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+        use std::io::Write;
+        child.stdin.take().unwrap().write_all(request.to_string().replace("\"NaN\"", "NaN").as_bytes()).unwrap();
+        let o = child.wait_with_output().unwrap();
+        assert!(o.status.success(), "dds_peer.py: {}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice::<Value>(&o.stdout).unwrap()
+    };
+    assert_eq!(answer["matched"], true, "no DDS match on loopback");
+
+    let same = |got: &Value, want: &Value, what: &str| {
+        assert_eq!(got["in_collision"], want["in_collision"], "{what}");
+        let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
+        assert_eq!(g.len(), w.len(), "{what}: colliding links");
+        for (a, b) in g.iter().zip(w) {
+            assert_eq!(a["link_name"], b["link_name"], "{what}");
+            assert_eq!(a["object_name"], b["object_name"], "{what}");
+            assert_eq!(a["triangle"], b["triangle"], "{what}");
+            assert!((a["depth"].as_f64().unwrap() - b["depth"].as_f64().unwrap()).abs() <= 1e-9, "{what}: depth");
+            for k in ["position", "normal"] {
+                for i in 0..3 {
+                    assert!((a[k][i].as_f64().unwrap() - b[k][i].as_f64().unwrap()).abs() <= 1e-9, "{what}: {k}");
+                }
+            }
+        }
+    };
+    let reports = answer["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), states.len(), "one report per state sent one at a time");
+    for (k, (got, want)) in reports.iter().zip(&reference).enumerate() {
+        same(got, want, &format!("topic, state {k}"));
+        assert_eq!(got["stamp"].as_i64().unwrap(), 1_000_000_000 + k as i64, "stamped with the input's stamp");
+        assert_eq!(got["frame_id"], "world");
+    }
+    let service = answer["service"].as_array().unwrap();
+    assert_eq!(service.len(), 5, "check_states answers every state");
+    for (k, (got, want)) in service.iter().zip(&reference).enumerate() {
+        same(got, want, &format!("service, state {k}"));
+    }
+
+    // SIGTERM: a clean shutdown.
+    let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
+    let status = node.wait().unwrap();
+    let mut rest = String::new();
+    let _ = std::io::Read::read_to_string(&mut out, &mut rest);
+    let mut err = String::new();
+    let _ = std::io::Read::read_to_string(&mut node.stderr.take().unwrap(), &mut err);
+    assert!(status.success(), "exit {status:?}; stderr: {err}");
+    assert!(rest.contains("shutting down"), "{rest}");
+    // The bad messages were warned about and skipped, the node kept running.
+    assert!(err.contains("2 positions") || err.contains("1 positions"), "lengths: {err}");
+    assert!(err.contains("another_robots_joint") || err.contains("not a joint"), "unknown joint: {err}");
+    eprintln!("node stderr:\n{err}\nnode stdout tail: {rest}");
+}
