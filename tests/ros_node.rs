@@ -52,7 +52,10 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     let lines: Vec<String> = states.iter().map(|(n, p)| json!({"name": n, "position": p}).to_string()).collect();
     let file = dir.join("states.jsonl");
     std::fs::write(&file, lines.join("\n") + "\n").unwrap();
-    let reference = Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--params-file", params.to_str().unwrap(), "--states", file.to_str().unwrap(), "--json"]).output().unwrap();
+    // The node's parameters after the set below: default_thickness 0.2, the rest as in the file.
+    let after = dir.join("params_after.yaml");
+    std::fs::write(&after, std::fs::read_to_string(&params).unwrap().replace("default_thickness: 0.02", "default_thickness: 0.2")).unwrap();
+    let reference = Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--params-file", after.to_str().unwrap(), "--states", file.to_str().unwrap(), "--json"]).output().unwrap();
     assert!(reference.status.success());
     let reference: Vec<Value> = String::from_utf8(reference.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert!(reference.iter().any(|r| r["in_collision"] == true) && reference.iter().any(|r| r["in_collision"] == false));
@@ -70,7 +73,15 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
         "states": states.iter().enumerate().map(|(k, (n, p))| json!({"name": n, "position": p, "stamp": 1_000_000_000 + k})).collect::<Vec<_>>(),
         "service_states": states[..5].iter().map(|(n, p)| json!({"name": n, "position": p})).collect::<Vec<_>>(),
         "timeout": 30,
+        "node": "tc_test",
+        "set_thickness": 0.2,
+        "burst": 10_000,
     });
+    let rss = |pid: u32| -> u64 {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+        status.lines().find(|l| l.starts_with("VmRSS:")).and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse().ok()).unwrap_or(0)
+    };
+    let rss_before = rss(node.id());
     let answer = {
         let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
         let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
@@ -81,6 +92,14 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
         serde_json::from_slice::<Value>(&o.stdout).unwrap()
     };
     assert_eq!(answer["matched"], true, "no DDS match on loopback");
+    let rss_after = rss(node.id());
+    eprintln!("node RSS: {} KiB before, {} KiB after a 10,000-state burst and the bad messages", rss_before, rss_after);
+    assert!(rss_before > 0 && rss_after < rss_before + 50 * 1024, "resident memory grew by more than 50 MiB");
+    // Parameter services: get, a refused set, a set that rebuilds the cells, get again.
+    assert_eq!(answer["get_before"], json!([0.02, "world"]));
+    assert_eq!(answer["set_results"][0][0], false, "a negative thickness is refused: {}", answer["set_results"]);
+    assert_eq!(answer["set_results"][1][0], true, "{}", answer["set_results"]);
+    assert_eq!(answer["get_after"], json!(0.2));
 
     let same = |got: &Value, want: &Value, what: &str| {
         assert_eq!(got["in_collision"], want["in_collision"], "{what}");

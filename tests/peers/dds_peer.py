@@ -75,6 +75,41 @@ Request = struct_typed("thickness_collision_msgs/srv/CheckStates_Request", [("gu
 Response = struct_typed("thickness_collision_msgs/srv/CheckStates_Response", [("guid", t.uint64), ("seq", t.int64), ("reports", t.sequence[CollisionReport])])
 
 
+# rcl_interfaces, for the node's standard parameter services.
+ParameterValue = struct_typed("rcl_interfaces/msg/ParameterValue", [
+    ("type", t.uint8), ("bool_value", bool), ("integer_value", t.int64), ("double_value", t.float64), ("string_value", str),
+    ("byte_array_value", t.sequence[t.uint8]), ("bool_array_value", t.sequence[bool]), ("integer_array_value", t.sequence[t.int64]),
+    ("double_array_value", t.sequence[t.float64]), ("string_array_value", t.sequence[str])])
+Parameter = struct_typed("rcl_interfaces/msg/Parameter", [("name", str), ("value", ParameterValue)])
+SetParametersResult = struct_typed("rcl_interfaces/msg/SetParametersResult", [("successful", bool), ("reason", str)])
+# ros2-client serves parameters with the "enhanced" RPC mapping (the request id travels as the
+# sample identity, not in the payload), so these carry no (guid, seq) header.
+GetReq = struct_typed("rcl_interfaces/srv/GetParameters_Request", [("names", t.sequence[str])])
+GetResp = struct_typed("rcl_interfaces/srv/GetParameters_Response", [("values", t.sequence[ParameterValue])])
+SetReq = struct_typed("rcl_interfaces/srv/SetParameters_Request", [("parameters", t.sequence[Parameter])])
+SetResp = struct_typed("rcl_interfaces/srv/SetParameters_Response", [("results", t.sequence[SetParametersResult])])
+
+
+def pv_double(x):
+    return ParameterValue(type=3, bool_value=False, integer_value=0, double_value=float(x), string_value="", byte_array_value=[],
+                          bool_array_value=[], integer_array_value=[], double_array_value=[], string_array_value=[])
+
+
+def call(dp, service, req_type, resp_type, request, wait=10):
+    w = DataWriter(dp, Topic(dp, f"rq/{service}Request", req_type), qos=reliable)
+    r = DataReader(dp, Topic(dp, f"rr/{service}Reply", resp_type), qos=reliable)
+    end = time.time() + wait
+    while (w.get_matched_subscriptions() == [] or r.get_matched_publications() == []) and time.time() < end:
+        time.sleep(0.05)
+    time.sleep(0.2)
+    w.write(request)
+    while time.time() < end:
+        for x in r.take(N=10):
+            return x
+        time.sleep(0.01)
+    return None
+
+
 def js(s):
     ns = int(s.get("stamp", 0))
     return JointState(header=Header(stamp=Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000), frame_id=""),
@@ -110,6 +145,25 @@ def collect(n, wait):
         time.sleep(0.005)
     return got
 
+
+node = req.get("node")
+if node and req.get("set_thickness") is not None:
+    g = call(dp, f"{node}/get_parameters", GetReq, GetResp, GetReq(names=["default_thickness", "world_frame"]))
+    out["get_before"] = None if g is None else [g.values[0].double_value, g.values[1].string_value]
+    res = []
+    for value in [-1.0, req["set_thickness"]]:  # a bad value first: refused, nothing changes
+        sresp = call(dp, f"{node}/set_parameters", SetReq, SetResp, SetReq(parameters=[Parameter(name="default_thickness", value=pv_double(value))]))
+        res.append(None if sresp is None else [bool(sresp.results[0].successful), sresp.results[0].reason])
+    out["set_results"] = res
+    g = call(dp, f"{node}/get_parameters", GetReq, GetResp, GetReq(names=["default_thickness"]))
+    out["get_after"] = None if g is None else g.values[0].double_value
+
+burst = req.get("burst", 0)
+for k in range(burst):
+    writer.write(js({"name": ["elbow_joint"], "position": [(k % 100) / 100.0], "stamp": k}))
+if burst:
+    time.sleep(1.0)
+    collect(10 ** 9, 1.0)
 
 for bad in req.get("bad", []):
     writer.write(js(bad))
