@@ -26,7 +26,7 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     std::fs::create_dir_all(&dir).unwrap();
     let cyclone = dir.join("cyclone.xml");
     std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
-    let domain = 100 + std::process::id() % 100;
+    let domain = 100 + std::process::id() % 50;
     let params = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/params.yaml");
 
     let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
@@ -143,4 +143,86 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     assert!(err.contains("2 positions") || err.contains("1 positions"), "lengths: {err}");
     assert!(err.contains("another_robots_joint") || err.contains("not a joint"), "unknown joint: {err}");
     eprintln!("node stderr:\n{err}\nnode stdout tail: {rest}");
+}
+
+#[test]
+fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
+    use thickness_collision::checker::Checker;
+    use thickness_collision::math::pose_from_isometry;
+    use thickness_collision::model::Params;
+    let dir = std::env::temp_dir().join(format!("tc_ros_node_tf_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cyclone = dir.join("cyclone.xml");
+    std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
+    let domain = 150 + std::process::id() % 50;
+    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+        .args(["run", "--ros-args", "-r", "__ns:=/robot1", "-p", "pose_source:=tf", "-p", "frame_prefix:=robot1/"])
+        .env("ROS_DOMAIN_ID", domain.to_string())
+        .env("ROS_LOCALHOST_ONLY", "1")
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(node.stdout.take().unwrap());
+    let mut banner = String::new();
+    while !banner.contains("serves") {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
+        banner += &line;
+    }
+    assert!(banner.contains("/robot1/thickness_collision") && banner.contains("/tf"), "{banner}");
+
+    // Link poses from forward kinematics, sent as world -> robot1/<link> transforms.
+    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let mut tf_states = Vec::new();
+    let mut lines = Vec::new();
+    for k in 0..12 {
+        let (names, pos) = state(k);
+        let mut q = vec![0.0; checker.robot.joints.len()];
+        for (n, p) in names.iter().zip(&pos) {
+            q[checker.robot.joint(n).unwrap()] = *p;
+        }
+        let poses = checker.robot.forward_kinematics(&q, &nalgebra::Isometry3::identity());
+        let (mut tfs, mut line) = (Vec::new(), Vec::new());
+        for t in &checker.targets {
+            let p = pose_from_isometry(&poses[t.link]);
+            let r = [p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w];
+            tfs.push(json!({"parent": "world", "child": format!("robot1/{}", t.name), "translation": p.translation.to_array(), "rotation": r}));
+            line.push(json!({"link": t.name, "translation": p.translation.to_array(), "rotation": r}));
+        }
+        tf_states.push(json!({"stamp": 2_000_000_000 + k, "transforms": tfs}));
+        lines.push(json!({"transforms": line}).to_string());
+    }
+    let file = dir.join("tf.jsonl");
+    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
+    let reference = Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--states", file.to_str().unwrap(), "--json"]).output().unwrap();
+    assert!(reference.status.success());
+    let reference: Vec<Value> = String::from_utf8(reference.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+
+    let request = json!({"domain": domain, "ns": "/robot1", "states": [], "tf_states": tf_states, "timeout": 30});
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
+    let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    {
+        use std::io::Write;
+        child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
+    }
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success(), "dds_peer.py: {}", String::from_utf8_lossy(&o.stderr));
+    let answer: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
+    assert!(node.wait().unwrap().success());
+    assert_eq!(answer["tf_matched"], true);
+    let reports = answer["tf_reports"].as_array().unwrap();
+    assert_eq!(reports.len(), reference.len(), "one report per /tf message");
+    for (k, (got, want)) in reports.iter().zip(&reference).enumerate() {
+        assert_eq!(got["in_collision"], want["in_collision"], "tf state {k}");
+        let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
+        assert_eq!(g.len(), w.len(), "tf state {k}");
+        for (a, b) in g.iter().zip(w) {
+            assert_eq!(a["link_name"], b["link_name"]);
+            assert!((a["depth"].as_f64().unwrap() - b["depth"].as_f64().unwrap()).abs() <= 1e-9);
+        }
+        assert_eq!(got["stamp"].as_i64().unwrap(), 2_000_000_000 + k as i64);
+    }
 }

@@ -76,6 +76,10 @@ pub struct Params {
     pub checked_links: Vec<String>,
     /// Use visual geometry for links that have no collision geometry.
     pub use_visual_when_no_collision: bool,
+    /// Where the node takes robot states from: `joint_states` (forward kinematics) or `tf`.
+    pub pose_source: String,
+    /// Prefix of the robot's frames on `/tf` (e.g. `robot1/` when several robots share it).
+    pub frame_prefix: String,
 }
 
 impl Default for Params {
@@ -95,6 +99,8 @@ impl Default for Params {
             missing_joint: MissingJoint::Zero,
             checked_links: vec!["*".into()],
             use_visual_when_no_collision: false,
+            pose_source: "joint_states".into(),
+            frame_prefix: String::new(),
         }
     }
 }
@@ -182,6 +188,9 @@ impl Params {
         }
         if let Some(p) = self.allowed_collisions.iter().find(|p| p.split(':').count() != 2) {
             return bad("allowed_collisions", format!("'{p}' is not of the form robot_link:environment_link"));
+        }
+        if !matches!(self.pose_source.as_str(), "joint_states" | "tf") {
+            return bad("pose_source", format!("must be joint_states or tf, got '{}'", self.pose_source));
         }
         if let Some(p) = self.package_map.iter().find(|p| !p.contains('=')) {
             return bad("package_map", format!("'{p}' is not of the form package=/path"));

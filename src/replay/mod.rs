@@ -5,7 +5,6 @@
 mod bag_reader;
 mod bag_writer;
 mod replay_run;
-mod tf_tree;
 
 pub use self::bag_reader::{open_bag, BagError, BagMessage, BagReader};
 pub use self::bag_writer::BagWriter;

@@ -2,8 +2,7 @@
 
 use super::bag_reader::{open_bag, BagMessage};
 use super::bag_writer::BagWriter;
-use super::tf_tree::TfTree;
-use crate::checker::{Checker, JointMemory, StateReport};
+use crate::checker::{Checker, JointMemory, StateReport, TfTree};
 use crate::model::Params;
 use crate::msgs::{decode_cdr, CollisionReport, Header, JointState, StringMsg, TfMessage, Time};
 use anyhow::{bail, Context, Result};

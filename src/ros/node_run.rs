@@ -4,7 +4,11 @@ use super::msg_impls::{CheckStatesRequest, CheckStatesResponse};
 use super::ros_args::RosArgs;
 use crate::checker::{Checker, JointMemory, StateReport};
 use crate::model::Params;
-use crate::msgs::{CollisionReport, Header, JointState, Time};
+use crate::msgs::{CollisionReport, Header, JointState, TfMessage, Time};
+use crate::checker::TfTree;
+use ros2_client::MessageInfo;
+use std::pin::Pin;
+use futures::stream::FusedStream;
 use anyhow::{anyhow, Context as _, Result};
 use futures::{FutureExt, StreamExt};
 use ros2_client::dds::rustdds::{DomainParticipant, DomainParticipantBuilder};
@@ -192,6 +196,23 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         .create_topic(&ros_name(&out_name, &namespace)?, MessageTypeName::new("thickness_collision_msgs", "CollisionReport"), &reliable)
         .map_err(|e| anyhow!("topic {out_name}: {e:?}"))?;
     let subscription = node.create_subscription::<JointState>(&js_topic, None).map_err(|e| anyhow!("subscription: {e:?}"))?;
+    // /tf and /tf_static are absolute: the same for every robot, frames told apart by frame_prefix.
+    let use_tf = params.pose_source == "tf";
+    let (tf_sub, tf_static_sub) = if use_tf {
+        let latched = QosProfile::subscription_default()
+            .reliability_reliable(WhenFull::DEFAULT)
+            .durability(ros2_client::qos::Durability::TransientLocal)
+            .history(History::KeepLast { depth: 100 });
+        let tf_topic = node.create_topic(&ros_name(&resolve(remaps, "/tf"), "/")?, MessageTypeName::new("tf2_msgs", "TFMessage"), &best_effort).map_err(|e| anyhow!("topic /tf: {e:?}"))?;
+        let st_topic = node.create_topic(&ros_name(&resolve(remaps, "/tf_static"), "/")?, MessageTypeName::new("tf2_msgs", "TFMessage"), &latched).map_err(|e| anyhow!("topic /tf_static: {e:?}"))?;
+        let tf_qos = QosProfile::subscription_default().reliability_best_effort().history(History::KeepLast { depth: 100 });
+        (
+            Some(node.create_subscription::<TfMessage>(&tf_topic, Some(tf_qos)).map_err(|e| anyhow!("subscription /tf: {e:?}"))?),
+            Some(node.create_subscription::<TfMessage>(&st_topic, Some(latched)).map_err(|e| anyhow!("subscription /tf_static: {e:?}"))?),
+        )
+    } else {
+        (None, None)
+    };
     let publisher = node.create_publisher::<CollisionReport>(&out_topic, None).map_err(|e| anyhow!("publisher: {e:?}"))?;
     let server = node
         .create_server::<CheckStatesRequest, CheckStatesResponse>(
@@ -213,7 +234,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         );
         println!("  robot {} ({} links, {} checked)", s.robot_source, s.robot_links, s.checked_links);
         println!("  environment {} ({} thin surfaces, {} cells, {} solids), built in {:.1} ms", s.environment_source, s.thin_surfaces, s.cells, s.solids, s.build_seconds * 1e3);
-        println!("  subscribes {js_name} (sensor_msgs/msg/JointState), publishes {out_name} (thickness_collision_msgs/msg/CollisionReport), serves {srv_name}");
+        let input = if use_tf { format!("/tf and /tf_static (tf2_msgs/msg/TFMessage, frame prefix '{}')", params.frame_prefix) } else { format!("{js_name} (sensor_msgs/msg/JointState)") };
+        println!("  subscribes {input}, publishes {out_name} (thickness_collision_msgs/msg/CollisionReport), serves {srv_name}");
     }
 
     let stop = Arc::new(AtomicBool::new(false));
@@ -231,8 +253,12 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let mut memory: Option<JointMemory> = None;
         let (mut received, mut checked, mut skipped) = (0u64, 0u64, 0u64);
         let mut requests = server.receive_request_stream();
-        let states = subscription.async_stream();
-        futures::pin_mut!(states);
+        type Stream<'a, M> = Pin<Box<dyn FusedStream<Item = ros2_client::ReadResult<(M, MessageInfo)>> + 'a>>;
+        let mut states: Stream<JointState> = if use_tf { Box::pin(futures::stream::pending()) } else { Box::pin(subscription.async_stream()) };
+        let mut tfs: Stream<TfMessage> = match &tf_sub { Some(s) => Box::pin(s.async_stream()), None => Box::pin(futures::stream::pending()) };
+        let mut tf_statics: Stream<TfMessage> = match &tf_static_sub { Some(s) => Box::pin(s.async_stream()), None => Box::pin(futures::stream::pending()) };
+        let mut tree = TfTree::default();
+        let prefix = params.frame_prefix.clone();
         loop {
             if stop.load(Ordering::SeqCst) {
                 break;
@@ -275,6 +301,35 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                         Ok((report, _)) => {
                             checked += 1;
                             if publisher.async_publish(report_message(&report, latest.header.stamp, &world_frame)).await.is_err() {
+                                log.warn("publish", || format!("publishing on {out_name} failed"));
+                            }
+                        }
+                        Err(e) => log.warn("state", || format!("state rejected: {e}")),
+                    }
+                }
+                msg = tf_statics.select_next_some() => {
+                    if let Ok((m, _)) = msg {
+                        for bad in tree.update(&m) {
+                            log.warn("tf", || format!("non-finite transform for frame '{bad}' skipped"));
+                        }
+                    }
+                }
+                msg = tfs.select_next_some() => {
+                    let Ok((m, _)) = msg else { log.warn("read-tf", || "reading /tf failed".into()); continue };
+                    received += 1;
+                    for bad in tree.update(&m) {
+                        log.warn("tf", || format!("non-finite transform for frame '{bad}' skipped"));
+                    }
+                    let checker = match shared.read() { Ok(c) => c.clone(), Err(_) => break };
+                    let poses: Vec<(String, crate::math::Pose)> = checker.targets.iter().filter_map(|t| tree.world_pose(&format!("{prefix}{}", t.name), &world_frame).map(|p| (t.name.clone(), p))).collect();
+                    if poses.is_empty() {
+                        continue; // none of the robot's frames reach world_frame yet
+                    }
+                    let stamp = m.transforms.iter().map(|t| t.header.stamp).max().unwrap_or_default();
+                    match checker.check_transforms(&poses) {
+                        Ok(report) => {
+                            checked += 1;
+                            if publisher.async_publish(report_message(&report, stamp, &world_frame)).await.is_err() {
                                 log.warn("publish", || format!("publishing on {out_name} failed"));
                             }
                         }

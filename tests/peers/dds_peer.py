@@ -41,6 +41,10 @@ Point = struct_typed("geometry_msgs/msg/Point", [("x", t.float64), ("y", t.float
 Vector3 = struct_typed("geometry_msgs/msg/Vector3", [("x", t.float64), ("y", t.float64), ("z", t.float64)])
 JointState = struct_typed("sensor_msgs/msg/JointState", [("header", Header), ("name", t.sequence[str]), ("position", t.sequence[t.float64]),
                                                          ("velocity", t.sequence[t.float64]), ("effort", t.sequence[t.float64])])
+Quaternion = struct_typed("geometry_msgs/msg/Quaternion", [("x", t.float64), ("y", t.float64), ("z", t.float64), ("w", t.float64)])
+Transform = struct_typed("geometry_msgs/msg/Transform", [("translation", Vector3), ("rotation", Quaternion)])
+TransformStamped = struct_typed("geometry_msgs/msg/TransformStamped", [("header", Header), ("child_frame_id", str), ("transform", Transform)])
+TFMessage = struct_typed("tf2_msgs/msg/TFMessage", [("transforms", t.sequence[TransformStamped])])
 KNOWN = {"std_msgs/Header": Header, "geometry_msgs/Point": Point, "geometry_msgs/Vector3": Vector3, "sensor_msgs/JointState": JointState}
 PRIMS = {"string": str, "bool": bool, "uint32": t.uint32, "int32": t.int32, "float64": t.float64}
 
@@ -95,18 +99,24 @@ def pv_double(x):
                           bool_array_value=[], integer_array_value=[], double_array_value=[], string_array_value=[])
 
 
-def call(dp, service, req_type, resp_type, request, wait=10):
+def call(dp, service, req_type, resp_type, request, wait=15, make=None):
+    """One service call. Matching is seen on our side before the node has matched us, and a
+    request written in between is lost: so the request is sent again (with a fresh one from
+    `make(k)` when given) after each second without an answer."""
     w = DataWriter(dp, Topic(dp, f"rq/{service}Request", req_type), qos=reliable)
     r = DataReader(dp, Topic(dp, f"rr/{service}Reply", resp_type), qos=reliable)
     end = time.time() + wait
     while (w.get_matched_subscriptions() == [] or r.get_matched_publications() == []) and time.time() < end:
         time.sleep(0.05)
-    time.sleep(0.2)
-    w.write(request)
+    k = 0
     while time.time() < end:
-        for x in r.take(N=10):
-            return x
-        time.sleep(0.01)
+        w.write(make(k) if make else request)
+        k += 1
+        resend = time.time() + 1.0
+        while time.time() < min(resend, end):
+            for x in r.take(N=10):
+                return x
+            time.sleep(0.01)
     return None
 
 
@@ -127,11 +137,12 @@ req = json.load(sys.stdin)
 dp = DomainParticipant(req["domain"])
 reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(1000))
 best_effort = Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(1))
-writer = DataWriter(dp, Topic(dp, "rt/joint_states", JointState), qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(10)))
-reader = DataReader(dp, Topic(dp, "rt/collisions", CollisionReport), qos=reliable)
+ns = req.get("ns", "")  # the node's namespace, e.g. "/robot1"
+writer = DataWriter(dp, Topic(dp, f"rt{ns}/joint_states", JointState), qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(10)))
+reader = DataReader(dp, Topic(dp, f"rt{ns}/collisions", CollisionReport), qos=reliable)
 deadline = time.time() + req.get("timeout", 30)
-# Wait for the node's reader and writer to match ours.
-while (writer.get_matched_subscriptions() == [] or reader.get_matched_publications() == []) and time.time() < deadline:
+# Wait for the node's reader and writer to match ours (with /tf input it reads no joint states).
+while ((writer.get_matched_subscriptions() == [] and not req.get("tf_states")) or reader.get_matched_publications() == []) and time.time() < deadline:
     time.sleep(0.05)
 out = {"matched": writer.get_matched_subscriptions() != [], "reports": [], "service": []}
 
@@ -165,6 +176,14 @@ if burst:
     time.sleep(1.0)
     collect(10 ** 9, 1.0)
 
+# Warm-up: the node may not have matched our writer yet; send until a report comes back.
+if req.get("states") or req.get("bad"):
+    warm = {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}
+    end = time.time() + 15
+    while time.time() < end and not collect(1, 0.5):
+        writer.write(js(warm))
+    collect(10 ** 9, 0.3)
+
 for bad in req.get("bad", []):
     writer.write(js(bad))
     time.sleep(0.02)
@@ -174,15 +193,27 @@ for s in req["states"]:
     got = collect(1, 5)
     out["reports"].extend(got)
 if req.get("service_states"):
-    rq_w = DataWriter(dp, Topic(dp, "rq/check_statesRequest", Request), qos=reliable)
-    rr_r = DataReader(dp, Topic(dp, "rr/check_statesReply", Response), qos=reliable)
-    while (rq_w.get_matched_subscriptions() == [] or rr_r.get_matched_publications() == []) and time.time() < deadline:
+    sv = [js(s) for s in req["service_states"]]
+    r = call(dp, f"{ns.strip('/') + '/' if ns else ''}check_states", Request, Response, None,
+             make=lambda k: Request(guid=0x1234567890ABCDEF, seq=k + 1, states=sv))
+    if r is not None:
+        out["service"] = [report_json(x) for x in r.reports]
+        out["service_seq"] = int(r.seq)
+if req.get("tf_states"):
+    tf_w = DataWriter(dp, Topic(dp, "rt/tf", TFMessage), qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(10)))
+    end = time.time() + 15
+    while tf_w.get_matched_subscriptions() == [] and time.time() < end:
         time.sleep(0.05)
-    rq_w.write(Request(guid=0x1234567890ABCDEF, seq=1, states=[js(s) for s in req["service_states"]]))
-    end = time.time() + 10
-    while not out["service"] and time.time() < end:
-        for r in rr_r.take(N=10):
-            out["service"] = [report_json(x) for x in r.reports]
-            out["service_seq"] = int(r.seq)
-        time.sleep(0.01)
+    time.sleep(0.3)
+    out["tf_matched"] = tf_w.get_matched_subscriptions() != []
+    out["tf_reports"] = []
+    for st in req["tf_states"]:
+        ns = int(st["stamp"])
+        stamp = Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+        ts = [TransformStamped(header=Header(stamp=stamp, frame_id=x["parent"]), child_frame_id=x["child"],
+                               transform=Transform(translation=Vector3(x=x["translation"][0], y=x["translation"][1], z=x["translation"][2]),
+                                                   rotation=Quaternion(x=x["rotation"][0], y=x["rotation"][1], z=x["rotation"][2], w=x["rotation"][3])))
+              for x in st["transforms"]]
+        tf_w.write(TFMessage(transforms=ts))
+        out["tf_reports"].extend(collect(1, 5))
 json.dump(out, sys.stdout)

@@ -1,4 +1,5 @@
-//! The latest transform of every frame from `/tf` and `/tf_static`, and world poses from them.
+//! The latest transform of every frame from `/tf` and `/tf_static`, and world poses from them
+//! (shared by the node and the replay).
 
 use crate::math::{Pose, Rotation, Vector};
 use crate::msgs::TfMessage;
