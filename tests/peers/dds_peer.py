@@ -24,74 +24,12 @@ from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
-ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
-def struct_typed(ros_type, fields):
-    """An IDL struct named as ROS 2 names DDS types: pkg::msg::dds_::Type_."""
-    pkg, kind, name = ros_type.split("/")
-    cls = types.new_class(name, (IdlStruct,), {"typename": f"{pkg}::{kind}::dds_::{name}_"},
-                          lambda ns: ns.update({"__annotations__": dict(fields)}))
-    return dataclass(cls)
-
-
-Time = struct_typed("builtin_interfaces/msg/Time", [("sec", t.int32), ("nanosec", t.uint32)])
-Header = struct_typed("std_msgs/msg/Header", [("stamp", Time), ("frame_id", str)])
-Point = struct_typed("geometry_msgs/msg/Point", [("x", t.float64), ("y", t.float64), ("z", t.float64)])
-Vector3 = struct_typed("geometry_msgs/msg/Vector3", [("x", t.float64), ("y", t.float64), ("z", t.float64)])
-JointState = struct_typed("sensor_msgs/msg/JointState", [("header", Header), ("name", t.sequence[str]), ("position", t.sequence[t.float64]),
-                                                         ("velocity", t.sequence[t.float64]), ("effort", t.sequence[t.float64])])
-Quaternion = struct_typed("geometry_msgs/msg/Quaternion", [("x", t.float64), ("y", t.float64), ("z", t.float64), ("w", t.float64)])
-Transform = struct_typed("geometry_msgs/msg/Transform", [("translation", Vector3), ("rotation", Quaternion)])
-TransformStamped = struct_typed("geometry_msgs/msg/TransformStamped", [("header", Header), ("child_frame_id", str), ("transform", Transform)])
-TFMessage = struct_typed("tf2_msgs/msg/TFMessage", [("transforms", t.sequence[TransformStamped])])
-KNOWN = {"std_msgs/Header": Header, "geometry_msgs/Point": Point, "geometry_msgs/Vector3": Vector3, "sensor_msgs/JointState": JointState}
-PRIMS = {"string": str, "bool": bool, "uint32": t.uint32, "int32": t.int32, "float64": t.float64}
-
-
-def from_msg(pkg, kind, name, text, local):
-    """A Cyclone IDL struct from a .msg definition (the project's own files)."""
-    fields = []
-    for line in text.splitlines():
-        line = line.split("#", 1)[0].strip()
-        if not line:
-            continue
-        ty, fname = line.split()[:2]
-        seq = ty.endswith("[]")
-        ty = ty[:-2] if seq else ty
-        py = PRIMS.get(ty) or KNOWN.get(ty) or local.get(ty)
-        if py is None:
-            raise ValueError(f"{name}.msg: unknown type {ty}")
-        fields.append((fname, t.sequence[py] if seq else py))
-    return struct_typed(f"{pkg}/{kind}/{name}", fields)
-
-
-IFACE = ROOT / "interfaces" / "thickness_collision_msgs"
-local = {}
-local["Contact"] = from_msg("thickness_collision_msgs", "msg", "Contact", (IFACE / "msg/Contact.msg").read_text(), local)
-local["CollisionReport"] = from_msg("thickness_collision_msgs", "msg", "CollisionReport", (IFACE / "msg/CollisionReport.msg").read_text(), local)
-CollisionReport = local["CollisionReport"]
-req_text, resp_text = (IFACE / "srv/CheckStates.srv").read_text().split("---")
-# Cyclone's request/reply mapping puts a (guid, seq) header before the fields.
-ReqBody = from_msg("thickness_collision_msgs", "srv", "CheckStates_Request", req_text, local)
-RespBody = from_msg("thickness_collision_msgs", "srv", "CheckStates_Response", resp_text, local)
-Request = struct_typed("thickness_collision_msgs/srv/CheckStates_Request", [("guid", t.uint64), ("seq", t.int64), ("states", t.sequence[JointState])])
-Response = struct_typed("thickness_collision_msgs/srv/CheckStates_Response", [("guid", t.uint64), ("seq", t.int64), ("reports", t.sequence[CollisionReport])])
-
-
-# rcl_interfaces, for the node's standard parameter services.
-ParameterValue = struct_typed("rcl_interfaces/msg/ParameterValue", [
-    ("type", t.uint8), ("bool_value", bool), ("integer_value", t.int64), ("double_value", t.float64), ("string_value", str),
-    ("byte_array_value", t.sequence[t.uint8]), ("bool_array_value", t.sequence[bool]), ("integer_array_value", t.sequence[t.int64]),
-    ("double_array_value", t.sequence[t.float64]), ("string_array_value", t.sequence[str])])
-Parameter = struct_typed("rcl_interfaces/msg/Parameter", [("name", str), ("value", ParameterValue)])
-SetParametersResult = struct_typed("rcl_interfaces/msg/SetParametersResult", [("successful", bool), ("reason", str)])
-# ros2-client serves parameters with the "enhanced" RPC mapping (the request id travels as the
-# sample identity, not in the payload), so these carry no (guid, seq) header.
-GetReq = struct_typed("rcl_interfaces/srv/GetParameters_Request", [("names", t.sequence[str])])
-GetResp = struct_typed("rcl_interfaces/srv/GetParameters_Response", [("values", t.sequence[ParameterValue])])
-SetReq = struct_typed("rcl_interfaces/srv/SetParameters_Request", [("parameters", t.sequence[Parameter])])
-SetResp = struct_typed("rcl_interfaces/srv/SetParameters_Response", [("results", t.sequence[SetParametersResult])])
+from dds_types import *  # noqa: F401,F403 (the IDL types)
+import dds_types as _types
+t = _types.t
 
 
 def pv_double(x):
