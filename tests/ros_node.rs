@@ -226,3 +226,81 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
         assert_eq!(got["stamp"].as_i64().unwrap(), 2_000_000_000 + k as i64);
     }
 }
+
+#[test]
+fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
+    use thickness_collision::model::bundled_config_dir;
+    let dir = std::env::temp_dir().join(format!("tc_ros_node_desc_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cyclone = dir.join("cyclone.xml");
+    std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
+    let domain = 200 + std::process::id() % 30;
+    // The bundled arm with a fat forearm (radius 0.3 instead of 0.04): it reaches walls it did not.
+    let gripper = bundled_config_dir().join("example_workcell/gripper.obj");
+    let urdf = std::fs::read_to_string(bundled_config_dir().join("example_workcell/robot.urdf"))
+        .unwrap()
+        .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", gripper.display()))
+        .replace("<capsule radius=\"0.04\"", "<capsule radius=\"0.3\"");
+    let fat = dir.join("fat_arm.urdf");
+    std::fs::write(&fat, &urdf).unwrap();
+
+    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+        .args(["run"])
+        .env("ROS_DOMAIN_ID", domain.to_string())
+        .env("ROS_LOCALHOST_ONLY", "1")
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(node.stdout.take().unwrap());
+    let mut banner = String::new();
+    while !banner.contains("serves") {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
+        banner += &line;
+    }
+    let states: Vec<(Vec<&str>, Vec<f64>)> = (0..15).map(state).collect();
+    let lines: Vec<String> = states.iter().map(|(n, p)| json!({"name": n, "position": p}).to_string()).collect();
+    let file = dir.join("states.jsonl");
+    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
+    let check = |robot: Option<&std::path::Path>| -> Vec<Value> {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_thickness_collision"));
+        let _ = c.args(["check", "--states", file.to_str().unwrap(), "--json"]);
+        if let Some(r) = robot {
+            let _ = c.args(["--robot", r.to_str().unwrap()]);
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success());
+        String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+    };
+    let (thin, fat_ref) = (check(None), check(Some(&fat)));
+    let colliding = |v: &[Value]| v.iter().filter(|r| r["in_collision"] == true).count();
+    assert!(colliding(&fat_ref) > colliding(&thin), "the fat forearm must collide more often");
+
+    let request = json!({"domain": domain, "robot_descriptions": ["<robot name='broken'><link name='a'></robot>", urdf],
+        "states": states.iter().enumerate().map(|(k, (n, p))| json!({"name": n, "position": p, "stamp": k})).collect::<Vec<_>>(), "timeout": 30});
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
+    let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    {
+        use std::io::Write;
+        child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
+    }
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success(), "dds_peer.py: {}", String::from_utf8_lossy(&o.stderr));
+    let answer: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
+    assert!(node.wait().unwrap().success());
+    let mut rest = String::new();
+    let _ = std::io::Read::read_to_string(&mut out, &mut rest);
+    let mut err = String::new();
+    let _ = std::io::Read::read_to_string(&mut node.stderr.take().unwrap(), &mut err);
+    assert!(err.contains("robot_description rejected") && err.contains("malformed"), "{err}");
+    assert!(rest.contains("robot from robot_description"), "{rest}");
+    let reports = answer["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), fat_ref.len());
+    for (k, (got, want)) in reports.iter().zip(&fat_ref).enumerate() {
+        assert_eq!(got["in_collision"], want["in_collision"], "state {k}: the node must check the fat arm from the topic");
+        assert_eq!(got["contacts"].as_array().unwrap().len(), want["contacts"].as_array().unwrap().len(), "state {k}");
+    }
+}

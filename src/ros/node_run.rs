@@ -4,7 +4,7 @@ use super::msg_impls::{CheckStatesRequest, CheckStatesResponse};
 use super::ros_args::RosArgs;
 use crate::checker::{Checker, JointMemory, StateReport};
 use crate::model::Params;
-use crate::msgs::{CollisionReport, Header, JointState, TfMessage, Time};
+use crate::msgs::{CollisionReport, Header, JointState, StringMsg, TfMessage, Time};
 use crate::checker::TfTree;
 use ros2_client::MessageInfo;
 use std::pin::Pin;
@@ -196,6 +196,14 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         .create_topic(&ros_name(&out_name, &namespace)?, MessageTypeName::new("thickness_collision_msgs", "CollisionReport"), &reliable)
         .map_err(|e| anyhow!("topic {out_name}: {e:?}"))?;
     let subscription = node.create_subscription::<JointState>(&js_topic, None).map_err(|e| anyhow!("subscription: {e:?}"))?;
+    // robot_description: reliable, transient local (latched), as robot_state_publisher offers it.
+    let latched_qos = QosProfile::subscription_default()
+        .reliability_reliable(WhenFull::DEFAULT)
+        .durability(ros2_client::qos::Durability::TransientLocal)
+        .history(History::KeepLast { depth: 1 });
+    let desc_name = resolve(remaps, "robot_description");
+    let desc_topic = node.create_topic(&ros_name(&desc_name, &namespace)?, MessageTypeName::new("std_msgs", "String"), &latched_qos).map_err(|e| anyhow!("topic {desc_name}: {e:?}"))?;
+    let desc_sub = node.create_subscription::<StringMsg>(&desc_topic, Some(latched_qos.clone())).map_err(|e| anyhow!("subscription {desc_name}: {e:?}"))?;
     // /tf and /tf_static are absolute: the same for every robot, frames told apart by frame_prefix.
     let use_tf = params.pose_source == "tf";
     let (tf_sub, tf_static_sub) = if use_tf {
@@ -257,6 +265,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let mut states: Stream<JointState> = if use_tf { Box::pin(futures::stream::pending()) } else { Box::pin(subscription.async_stream()) };
         let mut tfs: Stream<TfMessage> = match &tf_sub { Some(s) => Box::pin(s.async_stream()), None => Box::pin(futures::stream::pending()) };
         let mut tf_statics: Stream<TfMessage> = match &tf_static_sub { Some(s) => Box::pin(s.async_stream()), None => Box::pin(futures::stream::pending()) };
+        let mut descriptions: Stream<StringMsg> = Box::pin(desc_sub.async_stream());
         let mut tree = TfTree::default();
         let prefix = params.frame_prefix.clone();
         loop {
@@ -305,6 +314,21 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                             }
                         }
                         Err(e) => log.warn("state", || format!("state rejected: {e}")),
+                    }
+                }
+                msg = descriptions.select_next_some() => {
+                    let Ok((d, _)) = msg else { log.warn("read-desc", || format!("reading {desc_name} failed")); continue };
+                    // A new robot: rebuilt off to the side and swapped in whole; a bad one is
+                    // reported and the running model stays.
+                    let current = match shared.read() { Ok(c) => c.params.clone(), Err(_) => break };
+                    match Checker::from_description(current, &d.data, &format!("{desc_name} topic"), opts.environment.as_deref()) {
+                        Ok(fresh) => {
+                            println!("thickness_collision: robot from {desc_name}: {} links, {} checked", fresh.summary.robot_links, fresh.summary.checked_links);
+                            memory = None;
+                            merged.clear();
+                            match shared.write() { Ok(mut c) => *c = Arc::new(fresh), Err(_) => break }
+                        }
+                        Err(e) => log.warn("description", || format!("{desc_name} rejected, keeping the current robot: {e}")),
                     }
                 }
                 msg = tf_statics.select_next_some() => {

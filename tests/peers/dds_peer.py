@@ -107,6 +107,18 @@ if node and req.get("set_thickness") is not None:
     g = call(dp, f"{node}/get_parameters", GetReq, GetResp, GetReq(names=["default_thickness"]))
     out["get_after"] = None if g is None else g.values[0].double_value
 
+if req.get("robot_descriptions"):
+    latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+    dw = DataWriter(dp, Topic(dp, f"rt{ns}/robot_description", _types.String), qos=latched)
+    end = time.time() + 15
+    while dw.get_matched_subscriptions() == [] and time.time() < end:
+        time.sleep(0.05)
+    time.sleep(0.5)
+    for text in req["robot_descriptions"]:
+        dw.write(_types.String(data=text))
+        time.sleep(1.0)  # the node rebuilds its model
+    out["description_matched"] = dw.get_matched_subscriptions() != []
+
 burst = req.get("burst", 0)
 for k in range(burst):
     writer.write(js({"name": ["elbow_joint"], "position": [(k % 100) / 100.0], "stamp": k}))

@@ -24,6 +24,7 @@ Point = struct_typed("geometry_msgs/msg/Point", [("x", t.float64), ("y", t.float
 Vector3 = struct_typed("geometry_msgs/msg/Vector3", [("x", t.float64), ("y", t.float64), ("z", t.float64)])
 JointState = struct_typed("sensor_msgs/msg/JointState", [("header", Header), ("name", t.sequence[str]), ("position", t.sequence[t.float64]),
                                                          ("velocity", t.sequence[t.float64]), ("effort", t.sequence[t.float64])])
+String = struct_typed("std_msgs/msg/String", [("data", str)])
 Quaternion = struct_typed("geometry_msgs/msg/Quaternion", [("x", t.float64), ("y", t.float64), ("z", t.float64), ("w", t.float64)])
 Transform = struct_typed("geometry_msgs/msg/Transform", [("translation", Vector3), ("rotation", Quaternion)])
 TransformStamped = struct_typed("geometry_msgs/msg/TransformStamped", [("header", Header), ("child_frame_id", str), ("transform", Transform)])
