@@ -74,6 +74,7 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
         "service_states": states[..5].iter().map(|(n, p)| json!({"name": n, "position": p})).collect::<Vec<_>>(),
         "timeout": 30,
         "node": "tc_test",
+        "markers": true,
         "set_thickness": 0.2,
         "burst": 10_000,
     });
@@ -95,6 +96,16 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     let rss_after = rss(node.id());
     eprintln!("node RSS: {} KiB before, {} KiB after a 10,000-state burst and the bad messages", rss_before, rss_after);
     assert!(rss_before > 0 && rss_after < rss_before + 50 * 1024, "resident memory grew by more than 50 MiB");
+    // The cells as RViz markers (latched: a late subscriber gets them), and the status.
+    let cells = answer["cells_markers"].as_array().unwrap_or_else(|| panic!("no cell markers: {answer}"));
+    assert_eq!(cells.len(), 3, "one triangle list per thin surface");
+    let triangles: u64 = cells.iter().map(|m| m["points"].as_u64().unwrap() / 3).sum();
+    assert_eq!(triangles, 8 * 4112, "8 triangles per cell, every cell of the workcell (under marker_max_cells)");
+    assert!(cells.iter().all(|m| m["type"] == 11 && m["frame"] == "world"));
+    let diag = &answer["diagnostics"].as_array().unwrap_or_else(|| panic!("no /diagnostics: {answer}"))[0];
+    for key in ["input_rate_hz", "states_received", "states_checked", "states_skipped", "check_seconds_mean", "check_seconds_max"] {
+        assert!(diag["values"][key].is_string(), "diagnostics lack {key}: {diag}");
+    }
     // Parameter services: get, a refused set, a set that rebuilds the cells, get again.
     assert_eq!(answer["get_before"], json!([0.02, "world"]));
     assert_eq!(answer["set_results"][0][0], false, "a negative thickness is refused: {}", answer["set_results"]);

@@ -80,6 +80,10 @@ pub struct Params {
     pub pose_source: String,
     /// Prefix of the robot's frames on `/tf` (e.g. `robot1/` when several robots share it).
     pub frame_prefix: String,
+    /// At most this many cells are drawn on `collision_markers/cells`.
+    pub marker_max_cells: i64,
+    /// At most this many contact marker messages per second (Hz).
+    pub marker_rate: f64,
 }
 
 impl Default for Params {
@@ -101,6 +105,8 @@ impl Default for Params {
             use_visual_when_no_collision: false,
             pose_source: "joint_states".into(),
             frame_prefix: String::new(),
+            marker_max_cells: 20_000,
+            marker_rate: 10.0,
         }
     }
 }
@@ -188,6 +194,12 @@ impl Params {
         }
         if let Some(p) = self.allowed_collisions.iter().find(|p| p.split(':').count() != 2) {
             return bad("allowed_collisions", format!("'{p}' is not of the form robot_link:environment_link"));
+        }
+        if self.marker_max_cells < 0 {
+            return bad("marker_max_cells", format!("must be >= 0, got {}", self.marker_max_cells));
+        }
+        if !(self.marker_rate > 0.0 && self.marker_rate.is_finite()) {
+            return bad("marker_rate", format!("must be a positive rate in Hz, got {}", self.marker_rate));
         }
         if !matches!(self.pose_source.as_str(), "joint_states" | "tf") {
             return bad("pose_source", format!("must be joint_states or tf, got '{}'", self.pose_source));

@@ -171,3 +171,147 @@ impl CollisionReport {
         }
     }
 }
+
+/// `std_msgs/msg/ColorRGBA`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ColorRgba {
+    /// Red.
+    pub r: f32,
+    /// Green.
+    pub g: f32,
+    /// Blue.
+    pub b: f32,
+    /// Alpha.
+    pub a: f32,
+}
+
+/// `geometry_msgs/msg/Pose`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PoseMsg {
+    /// Position.
+    pub position: Point,
+    /// Orientation.
+    pub orientation: Quaternion,
+}
+
+/// `builtin_interfaces/msg/Duration`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DurationMsg {
+    /// Seconds.
+    pub sec: i32,
+    /// Nanoseconds.
+    pub nanosec: u32,
+}
+
+/// `sensor_msgs/msg/CompressedImage` (empty in markers).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CompressedImage {
+    /// Header.
+    pub header: Header,
+    /// Format.
+    pub format: String,
+    /// Data.
+    pub data: Vec<u8>,
+}
+
+/// `visualization_msgs/msg/UVCoordinate`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct UvCoordinate {
+    /// u.
+    pub u: f32,
+    /// v.
+    pub v: f32,
+}
+
+/// `visualization_msgs/msg/MeshFile`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MeshFile {
+    /// File name.
+    pub filename: String,
+    /// Data.
+    pub data: Vec<u8>,
+}
+
+/// `visualization_msgs/msg/Marker` (the Iron/Jazzy layout, with texture and mesh file fields).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Marker {
+    /// Header.
+    pub header: Header,
+    /// Namespace.
+    pub ns: String,
+    /// Id within the namespace.
+    pub id: i32,
+    /// Marker type (7 sphere list, 11 triangle list).
+    #[serde(rename = "type")]
+    pub kind: i32,
+    /// 0 add/modify, 2 delete, 3 delete all.
+    pub action: i32,
+    /// Pose.
+    pub pose: PoseMsg,
+    /// Scale.
+    pub scale: Vector3,
+    /// Colour.
+    pub color: ColorRgba,
+    /// How long the marker lives (0: forever).
+    pub lifetime: DurationMsg,
+    /// Frame locked.
+    pub frame_locked: bool,
+    /// Points.
+    pub points: Vec<Point>,
+    /// Per-point colours.
+    pub colors: Vec<ColorRgba>,
+    /// Texture resource.
+    pub texture_resource: String,
+    /// Texture.
+    pub texture: CompressedImage,
+    /// UV coordinates.
+    pub uv_coordinates: Vec<UvCoordinate>,
+    /// Text.
+    pub text: String,
+    /// Mesh resource.
+    pub mesh_resource: String,
+    /// Mesh file.
+    pub mesh_file: MeshFile,
+    /// Mesh materials.
+    pub mesh_use_embedded_materials: bool,
+}
+
+/// `visualization_msgs/msg/MarkerArray`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MarkerArray {
+    /// Markers.
+    pub markers: Vec<Marker>,
+}
+
+/// `diagnostic_msgs/msg/KeyValue`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct KeyValue {
+    /// Key.
+    pub key: String,
+    /// Value.
+    pub value: String,
+}
+
+/// `diagnostic_msgs/msg/DiagnosticStatus`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DiagnosticStatus {
+    /// 0 OK, 1 WARN, 2 ERROR, 3 STALE.
+    pub level: u8,
+    /// Name.
+    pub name: String,
+    /// Message.
+    pub message: String,
+    /// Hardware id.
+    pub hardware_id: String,
+    /// Values.
+    pub values: Vec<KeyValue>,
+}
+
+/// `diagnostic_msgs/msg/DiagnosticArray`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DiagnosticArray {
+    /// Header.
+    pub header: Header,
+    /// Statuses.
+    pub status: Vec<DiagnosticStatus>,
+}

@@ -1,12 +1,14 @@
 //! The shared message types are ROS messages for ros2-client.
 
-use crate::msgs::{CollisionReport, JointState, StringMsg, TfMessage};
+use crate::msgs::{CollisionReport, DiagnosticArray, JointState, MarkerArray, StringMsg, TfMessage};
 use serde::{Deserialize, Serialize};
 
 impl ros2_client::Message for JointState {}
 impl ros2_client::Message for CollisionReport {}
 impl ros2_client::Message for TfMessage {}
 impl ros2_client::Message for StringMsg {}
+impl ros2_client::Message for MarkerArray {}
+impl ros2_client::Message for DiagnosticArray {}
 
 /// `thickness_collision_msgs/srv/CheckStates` request.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]

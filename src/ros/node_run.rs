@@ -4,7 +4,8 @@ use super::msg_impls::{CheckStatesRequest, CheckStatesResponse};
 use super::ros_args::RosArgs;
 use crate::checker::{Checker, JointMemory, StateReport};
 use crate::model::Params;
-use crate::msgs::{CollisionReport, Header, JointState, StringMsg, TfMessage, Time};
+use crate::msgs::{CollisionReport, DiagnosticArray, Header, JointState, MarkerArray, StringMsg, TfMessage, Time};
+use super::markers::{cell_markers, contact_markers, diagnostics, NodeStats};
 use crate::checker::TfTree;
 use ros2_client::MessageInfo;
 use std::pin::Pin;
@@ -222,6 +223,21 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         (None, None)
     };
     let publisher = node.create_publisher::<CollisionReport>(&out_topic, None).map_err(|e| anyhow!("publisher: {e:?}"))?;
+    // Markers: the cells once, latched (capped by marker_max_cells); contacts at most marker_rate.
+    let latched_pub = QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::DEFAULT)
+        .durability(ros2_client::qos::Durability::TransientLocal)
+        .history(History::KeepLast { depth: 1 });
+    let cells_name = resolve(remaps, "collision_markers/cells");
+    let contacts_name = resolve(remaps, "collision_markers/contacts");
+    let cells_topic = node.create_topic(&ros_name(&cells_name, &namespace)?, MessageTypeName::new("visualization_msgs", "MarkerArray"), &latched_pub).map_err(|e| anyhow!("topic {cells_name}: {e:?}"))?;
+    let contacts_topic = node.create_topic(&ros_name(&contacts_name, &namespace)?, MessageTypeName::new("visualization_msgs", "MarkerArray"), &reliable).map_err(|e| anyhow!("topic {contacts_name}: {e:?}"))?;
+    let diag_topic = node.create_topic(&ros_name(&resolve(remaps, "/diagnostics"), "/")?, MessageTypeName::new("diagnostic_msgs", "DiagnosticArray"), &reliable).map_err(|e| anyhow!("topic /diagnostics: {e:?}"))?;
+    let cells_pub = node.create_publisher::<MarkerArray>(&cells_topic, Some(latched_pub.clone())).map_err(|e| anyhow!("publisher {cells_name}: {e:?}"))?;
+    let contacts_pub = node.create_publisher::<MarkerArray>(&contacts_topic, None).map_err(|e| anyhow!("publisher {contacts_name}: {e:?}"))?;
+    let diag_pub = node.create_publisher::<DiagnosticArray>(&diag_topic, None).map_err(|e| anyhow!("publisher /diagnostics: {e:?}"))?;
+    let max_cells = params.marker_max_cells.max(0) as usize;
+    let marker_period = Duration::from_secs_f64(1.0 / params.marker_rate);
     let server = node
         .create_server::<CheckStatesRequest, CheckStatesResponse>(
             ServiceMapping::Cyclone,
@@ -259,7 +275,16 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let spin = smol::spawn(spinner.spin());
         let mut merged: HashMap<String, f64> = HashMap::new();
         let mut memory: Option<JointMemory> = None;
-        let (mut received, mut checked, mut skipped) = (0u64, 0u64, 0u64);
+        let mut stats = NodeStats::default();
+        let mut last_markers = Instant::now() - marker_period;
+        let mut last_diag = Instant::now();
+        let now_stamp = || Time::from_nanos(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as i64));
+        if let Ok(c) = shared.read() {
+            if cells_pub.publish(cell_markers(&c, max_cells, &world_frame, now_stamp())).is_err() {
+                log.warn("markers", || format!("publishing {cells_name} failed"));
+            }
+        }
+        let fqn = node.fully_qualified_name();
         let mut requests = server.receive_request_stream();
         type Stream<'a, M> = Pin<Box<dyn FusedStream<Item = ros2_client::ReadResult<(M, MessageInfo)>> + 'a>>;
         let mut states: Stream<JointState> = if use_tf { Box::pin(futures::stream::pending()) } else { Box::pin(subscription.async_stream()) };
@@ -272,6 +297,14 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
             if stop.load(Ordering::SeqCst) {
                 break;
             }
+            // Checked on every turn, not on the timer only: a busy input would starve it.
+            let elapsed = last_diag.elapsed();
+            if elapsed >= Duration::from_secs(1) {
+                last_diag = Instant::now();
+                if diag_pub.publish(diagnostics(&fqn, &mut stats, elapsed.as_secs_f64(), now_stamp())).is_err() {
+                    log.warn("diagnostics", || "publishing /diagnostics failed".into());
+                }
+            }
             let tick = FutureExt::fuse(smol::Timer::after(Duration::from_millis(100)));
             futures::pin_mut!(tick);
             futures::select! {
@@ -283,8 +316,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                     while let Ok(Some((m, _))) = subscription.take() {
                         batch.push(std::mem::replace(&mut latest, m));
                     }
-                    received += 1 + batch.len() as u64;
-                    skipped += batch.len() as u64;
+                    stats.received += 1 + batch.len() as u64;
+                    stats.skipped += batch.len() as u64;
                     let checker = match shared.read() { Ok(c) => c.clone(), Err(_) => break };
                     let memory = memory.get_or_insert_with(|| JointMemory::new(&checker.robot));
                     for m in batch.iter().chain(std::iter::once(&latest)) {
@@ -308,9 +341,18 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                     let (names, positions): (Vec<String>, Vec<f64>) = merged.iter().map(|(k, v)| (k.clone(), *v)).unzip();
                     match checker.check_joints(&names, &positions, memory, false) {
                         Ok((report, _)) => {
-                            checked += 1;
+                            stats.checked += 1;
+                            stats.window_checks += 1;
+                            stats.check_sum += report.check_seconds;
+                            stats.check_max = stats.check_max.max(report.check_seconds);
                             if publisher.async_publish(report_message(&report, latest.header.stamp, &world_frame)).await.is_err() {
                                 log.warn("publish", || format!("publishing on {out_name} failed"));
+                            }
+                            if last_markers.elapsed() >= marker_period {
+                                last_markers = Instant::now();
+                                if contacts_pub.publish(contact_markers(&report, &world_frame, latest.header.stamp)).is_err() {
+                                    log.warn("markers", || format!("publishing {contacts_name} failed"));
+                                }
                             }
                         }
                         Err(e) => log.warn("state", || format!("state rejected: {e}")),
@@ -326,6 +368,9 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                             println!("thickness_collision: robot from {desc_name}: {} links, {} checked", fresh.summary.robot_links, fresh.summary.checked_links);
                             memory = None;
                             merged.clear();
+                            if cells_pub.publish(cell_markers(&fresh, max_cells, &world_frame, now_stamp())).is_err() {
+                                log.warn("markers", || format!("publishing {cells_name} failed"));
+                            }
                             match shared.write() { Ok(mut c) => *c = Arc::new(fresh), Err(_) => break }
                         }
                         Err(e) => log.warn("description", || format!("{desc_name} rejected, keeping the current robot: {e}")),
@@ -340,7 +385,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 }
                 msg = tfs.select_next_some() => {
                     let Ok((m, _)) = msg else { log.warn("read-tf", || "reading /tf failed".into()); continue };
-                    received += 1;
+                    stats.received += 1;
                     for bad in tree.update(&m) {
                         log.warn("tf", || format!("non-finite transform for frame '{bad}' skipped"));
                     }
@@ -352,7 +397,10 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                     let stamp = m.transforms.iter().map(|t| t.header.stamp).max().unwrap_or_default();
                     match checker.check_transforms(&poses) {
                         Ok(report) => {
-                            checked += 1;
+                            stats.checked += 1;
+                            stats.window_checks += 1;
+                            stats.check_sum += report.check_seconds;
+                            stats.check_max = stats.check_max.max(report.check_seconds);
                             if publisher.async_publish(report_message(&report, stamp, &world_frame)).await.is_err() {
                                 log.warn("publish", || format!("publishing on {out_name} failed"));
                             }
@@ -390,7 +438,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 _ = tick => {}
             }
         }
-        println!("thickness_collision: shutting down ({received} states received, {checked} checked, {skipped} skipped as stale)");
+        println!("thickness_collision: shutting down ({} states received, {} checked, {} skipped as stale)", stats.received, stats.checked, stats.skipped);
         drop(spin);
     });
     Ok(())

@@ -149,6 +149,21 @@ if req.get("service_states"):
     if r is not None:
         out["service"] = [report_json(x) for x in r.reports]
         out["service_seq"] = int(r.seq)
+if req.get("markers"):
+    latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+    cells_r = DataReader(dp, Topic(dp, f"rt{ns}/collision_markers/cells", _types.MarkerArray), qos=latched)
+    diag_r = DataReader(dp, Topic(dp, "rt/diagnostics", _types.DiagnosticArray), qos=reliable)
+    end = time.time() + 10
+    cells, diag = None, None
+    while time.time() < end and (cells is None or diag is None):
+        for m in cells_r.take(N=10):
+            cells = [{"ns": mk.ns, "type": mk.type, "points": len(mk.points), "frame": mk.header.frame_id} for mk in m.markers]
+        for d in diag_r.take(N=10):
+            diag = [{"name": st.name, "values": {kv.key: kv.value for kv in st.values}} for st in d.status]
+        time.sleep(0.02)
+    out["cells_markers"] = cells
+    out["diagnostics"] = diag
+
 if req.get("tf_states"):
     tf_w = DataWriter(dp, Topic(dp, "rt/tf", TFMessage), qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(10)))
     end = time.time() + 15

@@ -76,3 +76,20 @@ GetReq = struct_typed("rcl_interfaces/srv/GetParameters_Request", [("names", t.s
 GetResp = struct_typed("rcl_interfaces/srv/GetParameters_Response", [("values", t.sequence[ParameterValue])])
 SetReq = struct_typed("rcl_interfaces/srv/SetParameters_Request", [("parameters", t.sequence[Parameter])])
 SetResp = struct_typed("rcl_interfaces/srv/SetParameters_Response", [("results", t.sequence[SetParametersResult])])
+
+# visualization_msgs and diagnostic_msgs, to read the node's markers and status.
+ColorRGBA = struct_typed("std_msgs/msg/ColorRGBA", [("r", t.float32), ("g", t.float32), ("b", t.float32), ("a", t.float32)])
+PoseMsg = struct_typed("geometry_msgs/msg/Pose", [("position", Point), ("orientation", Quaternion)])
+DurationMsg = struct_typed("builtin_interfaces/msg/Duration", [("sec", t.int32), ("nanosec", t.uint32)])
+CompressedImage = struct_typed("sensor_msgs/msg/CompressedImage", [("header", Header), ("format", str), ("data", t.sequence[t.uint8])])
+UVCoordinate = struct_typed("visualization_msgs/msg/UVCoordinate", [("u", t.float32), ("v", t.float32)])
+MeshFile = struct_typed("visualization_msgs/msg/MeshFile", [("filename", str), ("data", t.sequence[t.uint8])])
+Marker = struct_typed("visualization_msgs/msg/Marker", [
+    ("header", Header), ("ns", str), ("id", t.int32), ("type", t.int32), ("action", t.int32), ("pose", PoseMsg), ("scale", Vector3),
+    ("color", ColorRGBA), ("lifetime", DurationMsg), ("frame_locked", bool), ("points", t.sequence[Point]), ("colors", t.sequence[ColorRGBA]),
+    ("texture_resource", str), ("texture", CompressedImage), ("uv_coordinates", t.sequence[UVCoordinate]), ("text", str),
+    ("mesh_resource", str), ("mesh_file", MeshFile), ("mesh_use_embedded_materials", bool)])
+MarkerArray = struct_typed("visualization_msgs/msg/MarkerArray", [("markers", t.sequence[Marker])])
+KeyValue = struct_typed("diagnostic_msgs/msg/KeyValue", [("key", str), ("value", str)])
+DiagnosticStatus = struct_typed("diagnostic_msgs/msg/DiagnosticStatus", [("level", t.uint8), ("name", str), ("message", str), ("hardware_id", str), ("values", t.sequence[KeyValue])])
+DiagnosticArray = struct_typed("diagnostic_msgs/msg/DiagnosticArray", [("header", Header), ("status", t.sequence[DiagnosticStatus])])

@@ -1,0 +1,108 @@
+//! RViz markers of the cells and the contacts, and the `/diagnostics` status.
+
+use crate::checker::{Checker, StateReport};
+use crate::msgs::{ColorRgba, DiagnosticArray, DiagnosticStatus, DurationMsg, Header, KeyValue, Marker, MarkerArray, Point, Quaternion, Time, Vector3};
+
+const TRIANGLE_LIST: i32 = 11;
+const SPHERE_LIST: i32 = 7;
+
+fn point(v: crate::math::Vector) -> Point {
+    Point { x: v.x, y: v.y, z: v.z }
+}
+
+/// One triangle-list marker per thin surface with the faces of its cells (world frame), at most
+/// `max_cells` cells in all (the first ones of each object in turn).
+pub fn cell_markers(checker: &Checker, max_cells: usize, frame: &str, stamp: Time) -> MarkerArray {
+    let mut markers = Vec::new();
+    let mut left = max_cells;
+    for (id, object) in checker.scene.objects().iter().enumerate() {
+        let Some(area) = object.area() else { continue };
+        let mut points = Vec::new();
+        for cell in area.cells.iter().take(left) {
+            let v = cell.vertices().map(|p| object.pose * p);
+            let [b0, b1, b2, f0, f1, f2] = v;
+            let mut tri = vec![[b0, b2, b1], [f0, f1, f2]];
+            for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+                tri.push([v[i], v[j], v[3 + j]]);
+                tri.push([v[i], v[3 + j], v[3 + i]]);
+            }
+            points.extend(tri.into_iter().flatten().map(point));
+        }
+        left -= area.cells.len().min(left);
+        markers.push(Marker {
+            header: Header { stamp, frame_id: frame.to_owned() },
+            ns: format!("cells/{}", object.name),
+            id: id as i32,
+            kind: TRIANGLE_LIST,
+            pose: crate::msgs::PoseMsg { position: Point::default(), orientation: Quaternion::default() },
+            scale: Vector3 { x: 1.0, y: 1.0, z: 1.0 },
+            color: ColorRgba { r: 1.0, g: 0.55, b: 0.0, a: 0.35 },
+            points,
+            ..Default::default()
+        });
+    }
+    MarkerArray { markers }
+}
+
+/// A sphere list at the contact points of a report (cleared after half a second).
+pub fn contact_markers(report: &StateReport, frame: &str, stamp: Time) -> MarkerArray {
+    MarkerArray {
+        markers: vec![Marker {
+            header: Header { stamp, frame_id: frame.to_owned() },
+            ns: "contacts".into(),
+            id: 0,
+            kind: SPHERE_LIST,
+            pose: crate::msgs::PoseMsg { position: Point::default(), orientation: Quaternion::default() },
+            scale: Vector3 { x: 0.02, y: 0.02, z: 0.02 },
+            color: ColorRgba { r: 1.0, g: 0.0, b: 0.0, a: 1.0 },
+            lifetime: DurationMsg { sec: 0, nanosec: 500_000_000 },
+            points: report.contacts.iter().map(|c| Point { x: c.position[0], y: c.position[1], z: c.position[2] }).collect(),
+            ..Default::default()
+        }],
+    }
+}
+
+/// Counters the node keeps for `/diagnostics`.
+#[derive(Default)]
+pub struct NodeStats {
+    /// States received since start.
+    pub received: u64,
+    /// States checked since start.
+    pub checked: u64,
+    /// States skipped as stale since start.
+    pub skipped: u64,
+    /// Sum and maximum of check times since the last status (seconds).
+    pub check_sum: f64,
+    /// Maximum check time since the last status.
+    pub check_max: f64,
+    /// Checks since the last status.
+    pub window_checks: u64,
+    /// Received count at the last status.
+    pub last_received: u64,
+}
+
+/// The node's status: input rate, skips and check time over the last `seconds`.
+pub fn diagnostics(node: &str, stats: &mut NodeStats, seconds: f64, stamp: Time) -> DiagnosticArray {
+    let rate = (stats.received - stats.last_received) as f64 / seconds.max(1e-9);
+    let mean = if stats.window_checks > 0 { stats.check_sum / stats.window_checks as f64 } else { 0.0 };
+    let kv = |k: &str, v: String| KeyValue { key: k.into(), value: v };
+    let status = DiagnosticStatus {
+        level: 0,
+        name: format!("{node}: collision checks"),
+        message: format!("{rate:.1} states/s, {} skipped", stats.skipped),
+        hardware_id: String::new(),
+        values: vec![
+            kv("input_rate_hz", format!("{rate:.3}")),
+            kv("states_received", stats.received.to_string()),
+            kv("states_checked", stats.checked.to_string()),
+            kv("states_skipped", stats.skipped.to_string()),
+            kv("check_seconds_mean", format!("{mean:.9}")),
+            kv("check_seconds_max", format!("{:.9}", stats.check_max)),
+        ],
+    };
+    stats.last_received = stats.received;
+    stats.check_sum = 0.0;
+    stats.check_max = 0.0;
+    stats.window_checks = 0;
+    DiagnosticArray { header: Header { stamp, frame_id: String::new() }, status: vec![status] }
+}
