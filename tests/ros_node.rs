@@ -167,7 +167,7 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
     let domain = 150 + std::process::id() % 50;
     let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
-        .args(["run", "--ros-args", "-r", "__ns:=/robot1", "-p", "pose_source:=tf", "-p", "frame_prefix:=robot1/"])
+        .args(["run", "--ros-args", "-r", "__ns:=/robot1", "-p", "pose_source:=tf", "-p", "frame_prefix:=robot1/", "-p", "use_sim_time:=true", "-p", "service_mapping:=enhanced"])
         .env("ROS_DOMAIN_ID", domain.to_string())
         .env("ROS_LOCALHOST_ONLY", "1")
         .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
@@ -211,7 +211,9 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     assert!(reference.status.success());
     let reference: Vec<Value> = String::from_utf8(reference.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
 
-    let request = json!({"domain": domain, "ns": "/robot1", "states": [], "tf_states": tf_states, "timeout": 30});
+    let request = json!({"domain": domain, "ns": "/robot1", "states": [], "tf_states": tf_states, "timeout": 30,
+        "clock": 42_000_000_000i64, "markers": true, "service_mapping": "enhanced",
+        "service_states": [{"name": ["elbow_joint"], "position": [0.1]}]});
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
     let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
     {
@@ -224,6 +226,10 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
     assert!(node.wait().unwrap().success());
     assert_eq!(answer["tf_matched"], true);
+    // use_sim_time: the node's own messages carry /clock time.
+    assert_eq!(answer["diagnostics"][0]["stamp"], json!(42_000_000_000i64), "{}", answer["diagnostics"]);
+    // service_mapping: enhanced, as Fast DDS and Connext speak it.
+    assert_eq!(answer["service"].as_array().map(|v| v.len()), Some(1), "check_states over the enhanced mapping: {answer}");
     let reports = answer["tf_reports"].as_array().unwrap();
     assert_eq!(reports.len(), reference.len(), "one report per /tf message");
     for (k, (got, want)) in reports.iter().zip(&reference).enumerate() {

@@ -84,6 +84,11 @@ pub struct Params {
     pub marker_max_cells: i64,
     /// At most this many contact marker messages per second (Hz).
     pub marker_rate: f64,
+    /// Stamp the node's own messages (markers, diagnostics) with `/clock` time.
+    pub use_sim_time: bool,
+    /// Request/reply mapping of `check_states`: `cyclone` (rmw_cyclonedds), `enhanced` (Fast DDS,
+    /// Connext) or `basic`.
+    pub service_mapping: String,
 }
 
 impl Default for Params {
@@ -107,6 +112,8 @@ impl Default for Params {
             frame_prefix: String::new(),
             marker_max_cells: 20_000,
             marker_rate: 10.0,
+            use_sim_time: false,
+            service_mapping: "cyclone".into(),
         }
     }
 }
@@ -200,6 +207,9 @@ impl Params {
         }
         if !(self.marker_rate > 0.0 && self.marker_rate.is_finite()) {
             return bad("marker_rate", format!("must be a positive rate in Hz, got {}", self.marker_rate));
+        }
+        if !matches!(self.service_mapping.as_str(), "cyclone" | "enhanced" | "basic") {
+            return bad("service_mapping", format!("must be cyclone, enhanced or basic, got '{}'", self.service_mapping));
         }
         if !matches!(self.pose_source.as_str(), "joint_states" | "tf") {
             return bad("pose_source", format!("must be joint_states or tf, got '{}'", self.pose_source));

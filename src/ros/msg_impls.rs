@@ -25,3 +25,11 @@ pub struct CheckStatesResponse {
     pub reports: Vec<CollisionReport>,
 }
 impl ros2_client::Message for CheckStatesResponse {}
+
+/// `rosgraph_msgs/msg/Clock`.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+pub struct ClockMsg {
+    /// Simulated time.
+    pub clock: crate::msgs::Time,
+}
+impl ros2_client::Message for ClockMsg {}

@@ -1,6 +1,6 @@
 //! The node's life: participant, node, topics and service, and the loop that checks states.
 
-use super::msg_impls::{CheckStatesRequest, CheckStatesResponse};
+use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg};
 use super::ros_args::RosArgs;
 use crate::checker::{Checker, JointMemory, StateReport};
 use crate::model::Params;
@@ -180,6 +180,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         .declare_parameter("missing_joint", ParameterValue::String(format!("{:?}", params.missing_joint).to_lowercase()))
         .declare_parameter("allowed_collisions", ParameterValue::StringArray(params.allowed_collisions.clone()))
         .declare_parameter("checked_links", ParameterValue::StringArray(params.checked_links.clone()))
+        .declare_parameter("use_sim_time", ParameterValue::Boolean(params.use_sim_time))
+        .declare_parameter("service_mapping", ParameterValue::String(params.service_mapping.clone()))
         .parameter_set_action(Box::new(rebuild));
     let mut node = context
         .new_node(NodeName::new(&namespace, &node_name).map_err(|e| anyhow!("node name {namespace}/{node_name}: {e:?}"))?, options)
@@ -205,6 +207,13 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     let desc_name = resolve(remaps, "robot_description");
     let desc_topic = node.create_topic(&ros_name(&desc_name, &namespace)?, MessageTypeName::new("std_msgs", "String"), &latched_qos).map_err(|e| anyhow!("topic {desc_name}: {e:?}"))?;
     let desc_sub = node.create_subscription::<StringMsg>(&desc_topic, Some(latched_qos.clone())).map_err(|e| anyhow!("subscription {desc_name}: {e:?}"))?;
+    // /clock (rosgraph_msgs/Clock) when use_sim_time: the node's own stamps follow it.
+    let clock_sub = if params.use_sim_time {
+        let clock_topic = node.create_topic(&ros_name("/clock", "/")?, MessageTypeName::new("rosgraph_msgs", "Clock"), &best_effort).map_err(|e| anyhow!("topic /clock: {e:?}"))?;
+        Some(node.create_subscription::<ClockMsg>(&clock_topic, None).map_err(|e| anyhow!("subscription /clock: {e:?}"))?)
+    } else {
+        None
+    };
     // /tf and /tf_static are absolute: the same for every robot, frames told apart by frame_prefix.
     let use_tf = params.pose_source == "tf";
     let (tf_sub, tf_static_sub) = if use_tf {
@@ -240,7 +249,11 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     let marker_period = Duration::from_secs_f64(1.0 / params.marker_rate);
     let server = node
         .create_server::<CheckStatesRequest, CheckStatesResponse>(
-            ServiceMapping::Cyclone,
+            match params.service_mapping.as_str() {
+                "enhanced" => ServiceMapping::Enhanced,
+                "basic" => ServiceMapping::Basic,
+                _ => ServiceMapping::Cyclone,
+            },
             &ros_name(&srv_name, &namespace)?,
             &ServiceTypeName::new("thickness_collision_msgs", "CheckStates"),
             reliable.clone(),
@@ -278,7 +291,12 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let mut stats = NodeStats::default();
         let mut last_markers = Instant::now() - marker_period;
         let mut last_diag = Instant::now();
-        let now_stamp = || Time::from_nanos(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as i64));
+        let sim_time: std::cell::Cell<Option<Time>> = std::cell::Cell::new(None);
+        let now_stamp = || match sim_time.get() {
+            Some(t) => t,
+            None => Time::from_nanos(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as i64)),
+        };
+        let mut clocks: Stream<ClockMsg> = match &clock_sub { Some(s) => Box::pin(s.async_stream()), None => Box::pin(futures::stream::pending()) };
         if let Ok(c) = shared.read() {
             if cells_pub.publish(cell_markers(&c, max_cells, &world_frame, now_stamp())).is_err() {
                 log.warn("markers", || format!("publishing {cells_name} failed"));
@@ -356,6 +374,11 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                             }
                         }
                         Err(e) => log.warn("state", || format!("state rejected: {e}")),
+                    }
+                }
+                msg = clocks.select_next_some() => {
+                    if let Ok((c, _)) = msg {
+                        sim_time.set(Some(c.clock));
                     }
                 }
                 msg = descriptions.select_next_some() => {

@@ -144,22 +144,35 @@ for s in req["states"]:
     out["reports"].extend(got)
 if req.get("service_states"):
     sv = [js(s) for s in req["service_states"]]
-    r = call(dp, f"{ns.strip('/') + '/' if ns else ''}check_states", Request, Response, None,
-             make=lambda k: Request(guid=0x1234567890ABCDEF, seq=k + 1, states=sv))
+    if req.get("service_mapping") == "enhanced":
+        r = call(dp, f"{ns.strip('/') + '/' if ns else ''}check_states", _types.RequestEnhanced, _types.ResponseEnhanced, _types.RequestEnhanced(states=sv))
+    else:
+        r = call(dp, f"{ns.strip('/') + '/' if ns else ''}check_states", Request, Response, None,
+                 make=lambda k: Request(guid=0x1234567890ABCDEF, seq=k + 1, states=sv))
     if r is not None:
         out["service"] = [report_json(x) for x in r.reports]
-        out["service_seq"] = int(r.seq)
+        out["service_seq"] = int(getattr(r, "seq", 0))
+if req.get("clock") is not None:
+    cw = DataWriter(dp, Topic(dp, "rt/clock", _types.Clock), qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(1)))
+    ns_clock = int(req["clock"])
+    for _ in range(30):
+        cw.write(_types.Clock(clock=Time(sec=ns_clock // 1_000_000_000, nanosec=ns_clock % 1_000_000_000)))
+        time.sleep(0.05)
+
 if req.get("markers"):
     latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
     cells_r = DataReader(dp, Topic(dp, f"rt{ns}/collision_markers/cells", _types.MarkerArray), qos=latched)
     diag_r = DataReader(dp, Topic(dp, "rt/diagnostics", _types.DiagnosticArray), qos=reliable)
     end = time.time() + 10
+    if req.get("clock") is not None:
+        time.sleep(1.5)  # a status stamped after the clock arrived
+        diag_r.take(N=100)
     cells, diag = None, None
     while time.time() < end and (cells is None or diag is None):
         for m in cells_r.take(N=10):
             cells = [{"ns": mk.ns, "type": mk.type, "points": len(mk.points), "frame": mk.header.frame_id} for mk in m.markers]
         for d in diag_r.take(N=10):
-            diag = [{"name": st.name, "values": {kv.key: kv.value for kv in st.values}} for st in d.status]
+            diag = [{"name": st.name, "stamp": d.header.stamp.sec * 1_000_000_000 + d.header.stamp.nanosec, "values": {kv.key: kv.value for kv in st.values}} for st in d.status]
         time.sleep(0.02)
     out["cells_markers"] = cells
     out["diagnostics"] = diag

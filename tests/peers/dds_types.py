@@ -93,3 +93,7 @@ MarkerArray = struct_typed("visualization_msgs/msg/MarkerArray", [("markers", t.
 KeyValue = struct_typed("diagnostic_msgs/msg/KeyValue", [("key", str), ("value", str)])
 DiagnosticStatus = struct_typed("diagnostic_msgs/msg/DiagnosticStatus", [("level", t.uint8), ("name", str), ("message", str), ("hardware_id", str), ("values", t.sequence[KeyValue])])
 DiagnosticArray = struct_typed("diagnostic_msgs/msg/DiagnosticArray", [("header", Header), ("status", t.sequence[DiagnosticStatus])])
+Clock = struct_typed("rosgraph_msgs/msg/Clock", [("clock", Time)])
+# check_states without the Cyclone header, for the "enhanced" mapping.
+RequestEnhanced = struct_typed("thickness_collision_msgs/srv/CheckStates_Request", [("states", t.sequence[JointState])])
+ResponseEnhanced = struct_typed("thickness_collision_msgs/srv/CheckStates_Response", [("reports", t.sequence[CollisionReport])])
