@@ -12,10 +12,18 @@ pub struct TfTree {
 }
 
 impl TfTree {
-    /// Records every transform of a message; returns the child frames that were not finite.
+    /// Frames kept at most (a robot cell has hundreds).
+    pub const MAX_FRAMES: usize = 10_000;
+
+    /// Records every transform of a message; returns the child frames that were not finite, or
+    /// new frames past [`TfTree::MAX_FRAMES`] (a flood of made-up frames must not grow memory).
     pub fn update(&mut self, msg: &TfMessage) -> Vec<String> {
         let mut bad = Vec::new();
         for t in &msg.transforms {
+            if self.edges.len() >= Self::MAX_FRAMES && !self.edges.contains_key(strip(&t.child_frame_id)) {
+                bad.push(t.child_frame_id.clone());
+                continue;
+            }
             let (tr, q) = (t.transform.translation, t.transform.rotation);
             let rot = Rotation::from_xyzw(q.x, q.y, q.z, q.w);
             let v = Vector::new(tr.x, tr.y, tr.z);

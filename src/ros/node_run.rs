@@ -38,6 +38,8 @@ pub struct RunOptions {
 struct RateLimitedLog {
     last: HashMap<String, Instant>,
     suppressed: HashMap<String, u64>,
+    /// Messages written but not yet sent to `/rosout` (the node is borrowed elsewhere then).
+    pending: Vec<String>,
 }
 
 impl RateLimitedLog {
@@ -50,7 +52,11 @@ impl RateLimitedLog {
             _ => {
                 let n = self.suppressed.remove(cause).unwrap_or(0);
                 let more = if n > 0 { format!(" ({n} more like it in the last second)") } else { String::new() };
-                eprintln!("[WARN] thickness_collision: {}{more}", message());
+                let text = format!("{}{more}", message());
+                eprintln!("[WARN] thickness_collision: {text}");
+                if self.pending.len() < 64 {
+                    self.pending.push(text);
+                }
                 // Causes are a handful of fixed strings: the maps stay small.
                 let _ = self.last.insert(cause.to_owned(), now);
             }
@@ -181,6 +187,19 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         .declare_parameter("allowed_collisions", ParameterValue::StringArray(params.allowed_collisions.clone()))
         .declare_parameter("checked_links", ParameterValue::StringArray(params.checked_links.clone()))
         .declare_parameter("use_sim_time", ParameterValue::Boolean(params.use_sim_time))
+        .declare_parameter("robot_base_pose", ParameterValue::DoubleArray(params.robot_base_pose.clone()))
+        .declare_parameter("package_map", ParameterValue::StringArray(params.package_map.clone()))
+        .declare_parameter("thin_surfaces.patterns", ParameterValue::StringArray(params.thin_surfaces.patterns.clone()))
+        .declare_parameter("thin_surfaces.thickness", ParameterValue::DoubleArray(params.thin_surfaces.thickness.clone()))
+        .declare_parameter("thin_surfaces.side", ParameterValue::StringArray(params.thin_surfaces.side.clone()))
+        .declare_parameter("solid_hull", ParameterValue::StringArray(params.solid_hull.clone()))
+        .declare_parameter("padding.links", ParameterValue::StringArray(params.padding.links.clone()))
+        .declare_parameter("padding.values", ParameterValue::DoubleArray(params.padding.values.clone()))
+        .declare_parameter("use_visual_when_no_collision", ParameterValue::Boolean(params.use_visual_when_no_collision))
+        .declare_parameter("pose_source", ParameterValue::String(params.pose_source.clone()))
+        .declare_parameter("frame_prefix", ParameterValue::String(params.frame_prefix.clone()))
+        .declare_parameter("marker_max_cells", ParameterValue::Integer(params.marker_max_cells))
+        .declare_parameter("marker_rate", ParameterValue::Double(params.marker_rate))
         .declare_parameter("service_mapping", ParameterValue::String(params.service_mapping.clone()))
         .parameter_set_action(Box::new(rebuild));
     let mut node = context
@@ -315,6 +334,10 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
             if stop.load(Ordering::SeqCst) {
                 break;
             }
+            // Warnings go to /rosout too (the console already has them).
+            for text in log.pending.drain(..) {
+                ros2_client::rosout!(node, ros2_client::ros2::LogLevel::Warn, "{}", text);
+            }
             // Checked on every turn, not on the timer only: a busy input would starve it.
             let elapsed = last_diag.elapsed();
             if elapsed >= Duration::from_secs(1) {
@@ -402,7 +425,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 msg = tf_statics.select_next_some() => {
                     if let Ok((m, _)) = msg {
                         for bad in tree.update(&m) {
-                            log.warn("tf", || format!("non-finite transform for frame '{bad}' skipped"));
+                            log.warn("tf", || format!("transform for frame '{bad}' skipped (not finite, or past {} frames)", TfTree::MAX_FRAMES));
                         }
                     }
                 }
@@ -410,7 +433,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                     let Ok((m, _)) = msg else { log.warn("read-tf", || "reading /tf failed".into()); continue };
                     stats.received += 1;
                     for bad in tree.update(&m) {
-                        log.warn("tf", || format!("non-finite transform for frame '{bad}' skipped"));
+                        log.warn("tf", || format!("transform for frame '{bad}' skipped (not finite, or past {} frames)", TfTree::MAX_FRAMES));
                     }
                     let checker = match shared.read() { Ok(c) => c.clone(), Err(_) => break };
                     let poses: Vec<(String, crate::math::Pose)> = checker.targets.iter().filter_map(|t| tree.world_pose(&format!("{prefix}{}", t.name), &world_frame).map(|p| (t.name.clone(), p))).collect();
