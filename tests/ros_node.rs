@@ -225,6 +225,10 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     let answer: Value = serde_json::from_slice(&o.stdout).unwrap();
     let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
     assert!(node.wait().unwrap().success());
+    let mut err = String::new();
+    let _ = std::io::Read::read_to_string(&mut node.stderr.take().unwrap(), &mut err);
+    assert!(err.contains("unknown to the robot") && err.contains("camera_link"), "{err}");
+    assert_eq!(answer["tf_unknown_reports"], 0, "a TF for another frame is not a robot state");
     assert_eq!(answer["tf_matched"], true);
     // use_sim_time: the node's own messages carry /clock time.
     assert_eq!(answer["diagnostics"][0]["stamp"], json!(42_000_000_000i64), "{}", answer["diagnostics"]);

@@ -436,6 +436,17 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                         log.warn("tf", || format!("transform for frame '{bad}' skipped (not finite, or past {} frames)", TfTree::MAX_FRAMES));
                     }
                     let checker = match shared.read() { Ok(c) => c.clone(), Err(_) => break };
+                    // A message that names no frame of this robot (another robot's, a sensor's)
+                    // updates the tree but is not a robot state: warned about and skipped.
+                    let ours = m.transforms.iter().any(|t| {
+                        let child = t.child_frame_id.trim_start_matches('/');
+                        child.strip_prefix(prefix.as_str()).is_some_and(|link| checker.robot.link(link).is_some())
+                    });
+                    if !ours {
+                        let first = m.transforms.first().map(|t| t.child_frame_id.clone()).unwrap_or_default();
+                        log.warn("tf-unknown", || format!("/tf message for frames unknown to the robot (e.g. '{first}', prefix '{prefix}') skipped"));
+                        continue;
+                    }
                     let poses: Vec<(String, crate::math::Pose)> = checker.targets.iter().filter_map(|t| tree.world_pose(&format!("{prefix}{}", t.name), &world_frame).map(|p| (t.name.clone(), p))).collect();
                     if poses.is_empty() {
                         continue; // none of the robot's frames reach world_frame yet

@@ -185,6 +185,12 @@ if req.get("tf_states"):
     time.sleep(0.3)
     out["tf_matched"] = tf_w.get_matched_subscriptions() != []
     out["tf_reports"] = []
+    # First a message about somebody else's frame: warned about, no report.
+    other = Time(sec=1, nanosec=0)
+    tf_w.write(TFMessage(transforms=[TransformStamped(header=Header(stamp=other, frame_id="world"), child_frame_id="camera_link",
+                                                      transform=Transform(translation=Vector3(x=0.0, y=0.0, z=1.0), rotation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)))]))
+    time.sleep(0.3)
+    out["tf_unknown_reports"] = len(collect(10, 0.5))
     for st in req["tf_states"]:
         ns = int(st["stamp"])
         stamp = Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
