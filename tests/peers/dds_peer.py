@@ -134,6 +134,15 @@ if req.get("states") or req.get("bad"):
         writer.write(js(warm))
     collect(10 ** 9, 0.3)
 
+contacts_r = None
+if req.get("markers"):
+    contacts_r = DataReader(dp, Topic(dp, f"rt{ns}/collision_markers/contacts", _types.MarkerArray), qos=reliable)
+    end = time.time() + 10
+    while contacts_r.get_matched_publications() == [] and time.time() < end:
+        time.sleep(0.05)
+    contacts_r.take(N=1000)
+t_states = time.time()
+
 for bad in req.get("bad", []):
     writer.write(js(bad))
     time.sleep(0.02)
@@ -142,6 +151,12 @@ for s in req["states"]:
     writer.write(js(s))
     got = collect(1, 5)
     out["reports"].extend(got)
+if contacts_r is not None:
+    out["states_seconds"] = time.time() - t_states
+    time.sleep(0.3)
+    msgs = contacts_r.take(N=1000)
+    out["contact_markers"] = [{"type": m.markers[0].type, "points": len(m.markers[0].points)} for m in msgs if m.markers]
+
 if req.get("service_states"):
     sv = [js(s) for s in req["service_states"]]
     if req.get("service_mapping") == "enhanced":
