@@ -13,6 +13,41 @@ use std::process::{Command, Stdio};
 
 const CYCLONE_LOOPBACK: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers><Peer address="127.0.0.1"/></Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>"#;
 
+/// Starts the node with loopback-only DDS on `domain` and waits for its banner.
+fn start_node(args: &[&str], domain: u32) -> (std::process::Child, BufReader<std::process::ChildStdout>, String) {
+    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+        .arg("run")
+        .args(args)
+        .env("ROS_DOMAIN_ID", domain.to_string())
+        .env("ROS_LOCALHOST_ONLY", "1")
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(node.stdout.take().unwrap());
+    let mut banner = String::new();
+    while !banner.contains("serves") {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
+        banner += &line;
+    }
+    (node, out, banner)
+}
+
+/// Runs the Cyclone DDS peer with a loopback-only configuration; returns its JSON answer.
+fn run_dds_peer(cyclone: &std::path::Path, request: &Value) -> Value {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
+    let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    {
+        use std::io::Write;
+        child.stdin.take().unwrap().write_all(request.to_string().replace("\"NaN\"", "NaN").as_bytes()).unwrap();
+    }
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success(), "dds_peer.py: {}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
 fn state(k: usize) -> (Vec<&'static str>, Vec<f64>) {
     let names = vec!["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
     let x = k as f64;
@@ -29,22 +64,7 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     let domain = 100 + std::process::id() % 50;
     let params = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/params.yaml");
 
-    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
-        .args(["run", "--ros-args", "-r", "__node:=tc_test", "--params-file", params.to_str().unwrap()])
-        .env("ROS_DOMAIN_ID", domain.to_string())
-        .env("ROS_LOCALHOST_ONLY", "1")
-        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(node.stdout.take().unwrap());
-    let mut banner = String::new();
-    while !banner.contains("serves") {
-        let mut line = String::new();
-        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
-        banner += &line;
-    }
+    let (mut node, mut out, banner) = start_node(&["--ros-args", "-r", "__node:=tc_test", "--params-file", params.to_str().unwrap()], domain);
     assert!(banner.contains("/tc_test") && banner.contains("loopback only"), "{banner}");
 
     // The states, and check's answer for them.
@@ -83,15 +103,7 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
         status.lines().find(|l| l.starts_with("VmRSS:")).and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse().ok()).unwrap_or(0)
     };
     let rss_before = rss(node.id());
-    let answer = {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
-        let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
-        use std::io::Write;
-        child.stdin.take().unwrap().write_all(request.to_string().replace("\"NaN\"", "NaN").as_bytes()).unwrap();
-        let o = child.wait_with_output().unwrap();
-        assert!(o.status.success(), "dds_peer.py: {}", String::from_utf8_lossy(&o.stderr));
-        serde_json::from_slice::<Value>(&o.stdout).unwrap()
-    };
+    let answer = run_dds_peer(&cyclone, &request);
     assert_eq!(answer["matched"], true, "no DDS match on loopback");
     let rss_after = rss(node.id());
     eprintln!("node RSS: {} KiB before, {} KiB after a 10,000-state burst and the bad messages", rss_before, rss_after);
@@ -172,22 +184,7 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     let cyclone = dir.join("cyclone.xml");
     std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
     let domain = 150 + std::process::id() % 50;
-    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
-        .args(["run", "--ros-args", "-r", "__ns:=/robot1", "-p", "pose_source:=tf", "-p", "frame_prefix:=robot1/", "-p", "use_sim_time:=true", "-p", "service_mapping:=enhanced"])
-        .env("ROS_DOMAIN_ID", domain.to_string())
-        .env("ROS_LOCALHOST_ONLY", "1")
-        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(node.stdout.take().unwrap());
-    let mut banner = String::new();
-    while !banner.contains("serves") {
-        let mut line = String::new();
-        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
-        banner += &line;
-    }
+    let (mut node, _out, banner) = start_node(&["--ros-args", "-r", "__ns:=/robot1", "-p", "pose_source:=tf", "-p", "frame_prefix:=robot1/", "-p", "use_sim_time:=true", "-p", "service_mapping:=enhanced"], domain);
     assert!(banner.contains("/robot1/thickness_collision") && banner.contains("/tf"), "{banner}");
 
     // Link poses from forward kinematics, sent as world -> robot1/<link> transforms.
@@ -220,15 +217,7 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     let request = json!({"domain": domain, "ns": "/robot1", "states": [], "tf_states": tf_states, "timeout": 30,
         "clock": 42_000_000_000i64, "markers": true, "service_mapping": "enhanced",
         "service_states": [{"name": ["elbow_joint"], "position": [0.1]}]});
-    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
-    let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
-    {
-        use std::io::Write;
-        child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
-    }
-    let o = child.wait_with_output().unwrap();
-    assert!(o.status.success(), "dds_peer.py: {}", String::from_utf8_lossy(&o.stderr));
-    let answer: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let answer = run_dds_peer(&cyclone, &request);
     let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
     assert!(node.wait().unwrap().success());
     let mut err = String::new();
@@ -271,22 +260,7 @@ fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
     let fat = dir.join("fat_arm.urdf");
     std::fs::write(&fat, &urdf).unwrap();
 
-    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
-        .args(["run"])
-        .env("ROS_DOMAIN_ID", domain.to_string())
-        .env("ROS_LOCALHOST_ONLY", "1")
-        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(node.stdout.take().unwrap());
-    let mut banner = String::new();
-    while !banner.contains("serves") {
-        let mut line = String::new();
-        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
-        banner += &line;
-    }
+    let (mut node, mut out, _banner) = start_node(&[], domain);
     let states: Vec<(Vec<&str>, Vec<f64>)> = (0..15).map(state).collect();
     let lines: Vec<String> = states.iter().map(|(n, p)| json!({"name": n, "position": p}).to_string()).collect();
     let file = dir.join("states.jsonl");
@@ -307,15 +281,7 @@ fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
 
     let request = json!({"domain": domain, "robot_descriptions": ["<robot name='broken'><link name='a'></robot>", urdf],
         "states": states.iter().enumerate().map(|(k, (n, p))| json!({"name": n, "position": p, "stamp": k})).collect::<Vec<_>>(), "timeout": 30});
-    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
-    let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
-    {
-        use std::io::Write;
-        child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
-    }
-    let o = child.wait_with_output().unwrap();
-    assert!(o.status.success(), "dds_peer.py: {}", String::from_utf8_lossy(&o.stderr));
-    let answer: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let answer = run_dds_peer(&cyclone, &request);
     let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
     assert!(node.wait().unwrap().success());
     let mut rest = String::new();
