@@ -10,17 +10,6 @@ pub use parry3d_f64::math::{Pose, Real, Rotation, Vector};
 /// Axis-aligned bounding box, as the BVH wants it.
 pub use parry3d_f64::bounding_volume::Aabb;
 
-/// The unit vector along `v`, or `None` when `v` is too short to have a direction.
-#[inline]
-pub fn try_normalize(v: Vector, min_len: Real) -> Option<Vector> {
-    let len = v.length();
-    if len > min_len && len.is_finite() {
-        Some(v / len)
-    } else {
-        None
-    }
-}
-
 /// `[min, max]` of `dir . p` over `points` (the projection of a point set on an axis).
 #[inline]
 pub fn project_points(points: &[Vector], dir: Vector) -> [Real; 2] {

@@ -81,6 +81,16 @@ pub struct NodeStats {
     pub last_received: u64,
 }
 
+impl NodeStats {
+    /// Counts one checked state that took `seconds`.
+    pub fn record_check(&mut self, seconds: f64) {
+        self.checked += 1;
+        self.window_checks += 1;
+        self.check_sum += seconds;
+        self.check_max = self.check_max.max(seconds);
+    }
+}
+
 /// The node's status: input rate, skips and check time over the last `seconds`.
 pub fn diagnostics(node: &str, stats: &mut NodeStats, seconds: f64, stamp: Time) -> DiagnosticArray {
     let rate = (stats.received - stats.last_received) as f64 / seconds.max(1e-9);

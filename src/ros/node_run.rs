@@ -110,6 +110,12 @@ fn apply_param_overrides(params: Params, overrides: &[(String, String)]) -> Resu
     Ok(params)
 }
 
+/// Reliable, transient local ("latched"), keep last `depth`: how `robot_description`,
+/// `/tf_static` and the cell markers are offered.
+fn latched(base: QosProfile, depth: usize) -> QosProfile {
+    base.reliability_reliable(WhenFull::DEFAULT).durability(ros2_client::qos::Durability::TransientLocal).history(History::KeepLast { depth })
+}
+
 fn resolve(remaps: &[(String, String)], name: &str) -> String {
     remaps.iter().find(|(from, _)| from == name || from.trim_start_matches('/') == name).map_or(name.to_owned(), |(_, to)| to.clone())
 }
@@ -219,10 +225,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         .map_err(|e| anyhow!("topic {out_name}: {e:?}"))?;
     let subscription = node.create_subscription::<JointState>(&js_topic, None).map_err(|e| anyhow!("subscription: {e:?}"))?;
     // robot_description: reliable, transient local (latched), as robot_state_publisher offers it.
-    let latched_qos = QosProfile::subscription_default()
-        .reliability_reliable(WhenFull::DEFAULT)
-        .durability(ros2_client::qos::Durability::TransientLocal)
-        .history(History::KeepLast { depth: 1 });
+    let latched_qos = latched(QosProfile::subscription_default(), 1);
     let desc_name = resolve(remaps, "robot_description");
     let desc_topic = node.create_topic(&ros_name(&desc_name, &namespace)?, MessageTypeName::new("std_msgs", "String"), &latched_qos).map_err(|e| anyhow!("topic {desc_name}: {e:?}"))?;
     let desc_sub = node.create_subscription::<StringMsg>(&desc_topic, Some(latched_qos.clone())).map_err(|e| anyhow!("subscription {desc_name}: {e:?}"))?;
@@ -236,26 +239,20 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     // /tf and /tf_static are absolute: the same for every robot, frames told apart by frame_prefix.
     let use_tf = params.pose_source == "tf";
     let (tf_sub, tf_static_sub) = if use_tf {
-        let latched = QosProfile::subscription_default()
-            .reliability_reliable(WhenFull::DEFAULT)
-            .durability(ros2_client::qos::Durability::TransientLocal)
-            .history(History::KeepLast { depth: 100 });
+        let tf_static_qos = latched(QosProfile::subscription_default(), 100);
         let tf_topic = node.create_topic(&ros_name(&resolve(remaps, "/tf"), "/")?, MessageTypeName::new("tf2_msgs", "TFMessage"), &best_effort).map_err(|e| anyhow!("topic /tf: {e:?}"))?;
-        let st_topic = node.create_topic(&ros_name(&resolve(remaps, "/tf_static"), "/")?, MessageTypeName::new("tf2_msgs", "TFMessage"), &latched).map_err(|e| anyhow!("topic /tf_static: {e:?}"))?;
+        let st_topic = node.create_topic(&ros_name(&resolve(remaps, "/tf_static"), "/")?, MessageTypeName::new("tf2_msgs", "TFMessage"), &tf_static_qos).map_err(|e| anyhow!("topic /tf_static: {e:?}"))?;
         let tf_qos = QosProfile::subscription_default().reliability_best_effort().history(History::KeepLast { depth: 100 });
         (
             Some(node.create_subscription::<TfMessage>(&tf_topic, Some(tf_qos)).map_err(|e| anyhow!("subscription /tf: {e:?}"))?),
-            Some(node.create_subscription::<TfMessage>(&st_topic, Some(latched)).map_err(|e| anyhow!("subscription /tf_static: {e:?}"))?),
+            Some(node.create_subscription::<TfMessage>(&st_topic, Some(tf_static_qos)).map_err(|e| anyhow!("subscription /tf_static: {e:?}"))?),
         )
     } else {
         (None, None)
     };
     let publisher = node.create_publisher::<CollisionReport>(&out_topic, None).map_err(|e| anyhow!("publisher: {e:?}"))?;
     // Markers: the cells once, latched (capped by marker_max_cells); contacts at most marker_rate.
-    let latched_pub = QosProfile::publisher_default()
-        .reliability_reliable(WhenFull::DEFAULT)
-        .durability(ros2_client::qos::Durability::TransientLocal)
-        .history(History::KeepLast { depth: 1 });
+    let latched_pub = latched(QosProfile::publisher_default(), 1);
     let cells_name = resolve(remaps, "collision_markers/cells");
     let contacts_name = resolve(remaps, "collision_markers/contacts");
     let cells_topic = node.create_topic(&ros_name(&cells_name, &namespace)?, MessageTypeName::new("visualization_msgs", "MarkerArray"), &latched_pub).map_err(|e| anyhow!("topic {cells_name}: {e:?}"))?;
@@ -382,10 +379,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                     let (names, positions): (Vec<String>, Vec<f64>) = merged.iter().map(|(k, v)| (k.clone(), *v)).unzip();
                     match checker.check_joints(&names, &positions, memory, false) {
                         Ok((report, _)) => {
-                            stats.checked += 1;
-                            stats.window_checks += 1;
-                            stats.check_sum += report.check_seconds;
-                            stats.check_max = stats.check_max.max(report.check_seconds);
+                            stats.record_check(report.check_seconds);
                             if publisher.async_publish(report_message(&report, latest.header.stamp, &world_frame)).await.is_err() {
                                 log.warn("publish", || format!("publishing on {out_name} failed"));
                             }
@@ -454,10 +448,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                     let stamp = m.transforms.iter().map(|t| t.header.stamp).max().unwrap_or_default();
                     match checker.check_transforms(&poses) {
                         Ok(report) => {
-                            stats.checked += 1;
-                            stats.window_checks += 1;
-                            stats.check_sum += report.check_seconds;
-                            stats.check_max = stats.check_max.max(report.check_seconds);
+                            stats.record_check(report.check_seconds);
                             if publisher.async_publish(report_message(&report, stamp, &world_frame)).await.is_err() {
                                 log.warn("publish", || format!("publishing on {out_name} failed"));
                             }
