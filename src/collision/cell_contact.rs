@@ -1,10 +1,12 @@
 //! One target against one cell: the SAT, then what is reported for a colliding pair.
 
 use super::contact_point::{closest_on_cell, contact_capsule_cell, contact_cylinder_cell, contact_hull_cell};
+use super::cell_tree::{CellSlab, TargetView};
 use super::polytope::CellPolytope;
 use super::sat::{sat_capsule_cell, sat_hull_cell, sat_sphere_cell, SatOverlap};
 use super::target::{Target, TargetShape};
 use crate::math::{Pose, Real, Rotation, Vector};
+use parry3d_f64::math::Matrix;
 use crate::thickness::{Side, ThicknessCell};
 
 /// What a colliding target/cell pair reports, in the world frame.
@@ -42,8 +44,15 @@ impl<'a> LocalPair<'a> {
     /// The SAT; `None` when apart.
     #[inline]
     pub fn sat(&self) -> Option<SatOverlap> {
+        self.sat_cached(&mut Vector::ZERO)
+    }
+
+    /// The SAT, trying first an axis that separated a neighbouring cell (`Vector::ZERO`: none),
+    /// and keeping the axis that separates this one (hulls only).
+    #[inline]
+    pub fn sat_cached(&self, separating: &mut Vector) -> Option<SatOverlap> {
         match &self.target.shape {
-            TargetShape::Polytope(h) => sat_hull_cell(h, &self.cell),
+            TargetShape::Polytope(h) => sat_hull_cell(h, &self.cell, separating),
             TargetShape::Sphere { radius } => sat_sphere_cell(*radius, &self.cell),
             TargetShape::Capsule { half_height, radius } => sat_capsule_cell(*half_height, *radius, &self.cell),
             TargetShape::Cylinder { half_height, radius } => sat_cylinder_cell(*half_height, *radius, &self.cell),
@@ -78,21 +87,121 @@ impl<'a> LocalPair<'a> {
 /// (target frame) and the depth the pair reports if it collides: the claim's `Bmax - Amin` on that
 /// axis. `pos12` is the pose of the cell's object in the target's frame.
 #[inline]
-pub(crate) fn normal_axis(target: &Target, cell: &ThicknessCell, side: Side, pos12: &Pose, hint: &mut [u32; 2]) -> Option<(Vector, Real)> {
-    let n = pos12.rotation * cell.normal;
-    let shift = n.dot(pos12.translation);
-    let [b_min, b_max] = cell.normal_range().map(|x| x + shift);
-    let [a_min, a_max] = target.shape.project_hinted(n, hint);
-    if a_max <= b_min || b_max <= a_min || !(a_min.is_finite() && a_max.is_finite()) {
-        return None;
-    }
+pub(crate) fn normal_axis(target: &Target, cell: &CellSlab, side: Side, pos12: &Pose, hint: &mut [u32; 2]) -> Option<(Vector, Real)> {
+    normal_axis_deeper(target, cell, side, &Matrix::from_quat(pos12.rotation), pos12.translation, hint, Real::NEG_INFINITY)
+}
+
+/// [`normal_axis`] for a search that only wants pairs deeper than `floor`: the end of the target
+/// that gives the depth is projected first, and a cell that cannot beat `floor` costs one hill
+/// climb instead of two. `rotation` and `translation` make the pose of the cell's object in the
+/// target's frame (a matrix: rotating many normals by one quaternion costs more).
+#[inline]
+pub(crate) fn normal_axis_deeper(target: &Target, cell: &CellSlab, side: Side, rotation: &Matrix, translation: Vector, hint: &mut [u32; 2], floor: Real) -> Option<(Vector, Real)> {
+    let n = *rotation * cell.normal;
+    let shift = n.dot(translation);
+    let [b_min, b_max] = cell.range.map(|x| x + shift);
     let front = match side {
         Side::Back => true,
         Side::Front => false,
         Side::Both => n.dot(target.shape.centre()) >= cell.plane_offset + shift,
     };
-    Some(if front { (n, b_max - a_min) } else { (-n, a_max - b_min) })
+    // Apart on this axis when `a_max <= b_min` or `b_max <= a_min` (touching is apart); the
+    // negated comparisons also turn a NaN into "apart".
+    if front {
+        let a_min = -target.shape.support_hinted(-n, &mut hint[1]);
+        let depth = b_max - a_min;
+        if !(depth > 0.0 && depth > floor) {
+            return None;
+        }
+        let a_max = target.shape.support_hinted(n, &mut hint[0]);
+        (a_max > b_min).then_some((n, depth))
+    } else {
+        let a_max = target.shape.support_hinted(n, &mut hint[0]);
+        let depth = a_max - b_min;
+        if !(depth > 0.0 && depth > floor) {
+            return None;
+        }
+        let a_min = -target.shape.support_hinted(-n, &mut hint[1]);
+        (b_max > a_min).then_some((-n, depth))
+    }
 }
+
+/// Axes that separated cells near the ones a query is deciding, with the target's extent along
+/// each: next to each other, cells are mostly separated by one of a few axes (the faces of the
+/// link's side), and with the extent kept a cell is tested against an axis with two dot products.
+/// Everything in the surface's frame.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct RecentAxes {
+    /// `(axis, [min, max] of axis . x over the target)`.
+    axes: [(Vector, [Real; 2]); 4],
+    len: usize,
+    next: usize,
+}
+
+impl RecentAxes {
+    /// Keeps `axis` (surface frame, not zero) along which the target spans `range`.
+    pub fn remember(&mut self, axis: Vector, range: [Real; 2]) {
+        if self.axes[..self.len].iter().any(|(a, _)| *a == axis) {
+            return;
+        }
+        self.axes[self.next] = (axis, range);
+        self.len = (self.len + 1).min(self.axes.len());
+        self.next = (self.next + 1) % self.axes.len();
+    }
+
+    /// Whether one of the axes separates the target from the box (centre, half extents).
+    #[inline]
+    pub fn separate_box(&self, centre: Vector, half: Vector) -> bool {
+        self.axes[..self.len].iter().any(|(a, [lo, hi])| {
+            let c = a.dot(centre);
+            let r = a.abs().dot(half);
+            c + r <= *lo || c - r >= *hi
+        })
+    }
+
+    /// Whether one of the axes separates the target from the points.
+    #[inline]
+    fn separate_points(&self, points: &[Vector]) -> bool {
+        self.axes[..self.len].iter().any(|(a, [lo, hi])| {
+            let [b_min, b_max] = crate::math::project_points(points, *a);
+            !(hi - b_min > 0.0 && b_max - lo > 0.0)
+        })
+    }
+}
+
+/// Decides a target/cell pair without the full SAT where that is cheap: `Some(false)` when one of
+/// the `recent` axes or the line between the two centroids separates the pair (that line is then
+/// remembered), `Some(true)` when the cell's centroid lies strictly inside the target (then the
+/// interiors meet, and the exact SAT would find overlap on every axis), `None` when only the full
+/// test can tell.
+///
+/// A link pushed through a surface meets thousands of cells; most of those the search must
+/// decide are either beside the link (one of a few axes separates them) or wholly inside it, and
+/// the full SAT (hundreds of face and edge axes on a mesh hull) would only confirm that.
+#[inline]
+pub(crate) fn quick_decide(view: &TargetView, cell: &ThicknessCell, recent: &mut RecentAxes) -> Option<bool> {
+    let verts = cell.vertices();
+    if recent.separate_points(&verts) {
+        return Some(false);
+    }
+    let centroid = verts.iter().copied().sum::<Vector>() / 6.0;
+    let between = centroid - view.centre;
+    if between.length_squared() > 0.0 {
+        let range = view.extent_along(between);
+        let [b_min, b_max] = crate::math::project_points(&verts, between);
+        if !(range[1] - b_min > 0.0 && b_max - range[0] > 0.0) {
+            recent.remember(between, range);
+            return Some(false);
+        }
+    }
+    if view.target.shape.contains_strictly(view.object_in_target * centroid, INSIDE_MARGIN) && cell.contains_point(centroid, -INSIDE_MARGIN) {
+        return Some(true);
+    }
+    None
+}
+
+/// How far inside both shapes (metres) a point must be to decide a pair without the SAT.
+const INSIDE_MARGIN: Real = 1e-9;
 
 /// Checks one target against one cell of an object posed at `object_pose`, for a thin surface of
 /// the given `side`. With `want_point` the contact point is computed (clipping, the costly part).
@@ -115,7 +224,7 @@ pub(crate) fn normal_axis(target: &Target, cell: &ThicknessCell, side: Side, pos
 /// ```
 pub fn collide_target_cell(target: &Target, cell: &ThicknessCell, side: Side, object_pose: &Pose, want_point: bool) -> Option<CellHit> {
     let pos12 = target.pose.inv_mul(object_pose);
-    let (push, depth) = normal_axis(target, cell, side, &pos12, &mut [u32::MAX; 2])?;
+    let (push, depth) = normal_axis(target, &CellSlab::of(cell, 0), side, &pos12, &mut [u32::MAX; 2])?;
     let pair = LocalPair::new(target, cell, &pos12);
     let sat = pair.sat()?;
     let rot = target.pose.rotation;

@@ -11,9 +11,12 @@
 //!   the capsule's segment), which cover every face, edge and vertex of the Minkowski difference;
 //! - cylinders have no finite exact axis set: they are decided with parry's GJK/EPA.
 //!
-//! The broad phase is parry's BVH over each object's cells. What is reported is in `report`.
+//! The broad phase is a BVH over each object's cells whose nodes also bound the cells' normals
+//! (`cell_tree`), so the deepest contact is found without visiting every cell under a link. What
+//! is reported is in `report`.
 
 mod cell_contact;
+mod cell_tree;
 mod contact_point;
 mod polytope;
 mod report;
@@ -22,6 +25,24 @@ mod scene;
 mod target;
 
 pub use self::cell_contact::{collide_target_cell, CellHit};
+pub use self::cell_tree::CellTree;
 pub use self::report::{CollideSettings, Contact, TargetReport};
 pub use self::scene::{ObjectBody, Scene, SceneObject};
 pub use self::target::{ConvexHull, Target, TargetShape};
+
+#[allow(missing_docs)]
+pub struct Section(pub usize, pub std::time::Instant);
+impl Drop for Section {
+    fn drop(&mut self) {
+        let e = self.1.elapsed().as_nanos() as u64;
+        SECTIONS.with(|s| { let mut v = s.get(); v[self.0] += e; v[4 + self.0] += 1; s.set(v) });
+    }
+}
+thread_local! {
+    #[allow(missing_docs)]
+    pub static SECTIONS: std::cell::Cell<[u64; 8]> = const { std::cell::Cell::new([0; 8]) };
+}
+
+#[allow(missing_docs)]
+pub fn bench_support(t: &Target, d: crate::math::Vector) -> crate::math::Real { t.shape.support_hinted(d, &mut u32::MAX.clone()) }
+impl Target { #[allow(missing_docs)] pub fn shape_points(&self) -> &[crate::math::Vector] { match &self.shape { TargetShape::Polytope(h) => h.points(), _ => &[] } } }

@@ -1,12 +1,13 @@
 //! The environment: objects with their cells in a BVH, and the queries against them.
 
-use super::cell_contact::{normal_axis, LocalPair};
+use super::cell_contact::{normal_axis, normal_axis_deeper, quick_decide, LocalPair, RecentAxes};
 use super::report::{CollideSettings, Contact, TargetReport};
 use super::target::{Target, TargetShape};
 use crate::math::{Aabb, Pose, Real, Vector};
 use crate::thickness::ThicknessArea;
 use parry3d_f64::bounding_volume::BoundingVolume;
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use super::cell_tree::{CellTree, TargetView};
+use super::sat::SatOverlap;
 
 /// What an environment object is made of.
 pub enum ObjectBody {
@@ -14,8 +15,8 @@ pub enum ObjectBody {
     Surface {
         /// The cells, in the object's frame.
         area: ThicknessArea,
-        /// Broad phase over the cells' bounding boxes.
-        bvh: Bvh,
+        /// Broad phase over the cells, with bounds on their normals.
+        tree: CellTree,
     },
     /// A convex solid (a URDF primitive or a mesh checked as its hull), checked with parry's
     /// GJK/EPA; its contacts have `triangle = u32::MAX`.
@@ -52,10 +53,10 @@ impl SceneObject {
         }
     }
 
-    /// Bytes of the BVH (for memory reports); 0 for solids.
+    /// Bytes of the broad-phase tree (for memory reports); 0 for solids.
     pub fn bvh_memory(&self) -> usize {
         match &self.body {
-            ObjectBody::Surface { bvh, .. } => bvh.total_memory_size(),
+            ObjectBody::Surface { tree, .. } => tree.memory(),
             ObjectBody::Solid(_) => 0,
         }
     }
@@ -67,13 +68,6 @@ pub struct Scene {
     objects: Vec<SceneObject>,
 }
 
-/// The bounding box of a cell; parry's BVH compares with `<=`, so no rounding is needed in f64.
-fn cell_aabb(cell: &crate::thickness::ThicknessCell) -> Aabb {
-    let v = cell.vertices();
-    let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-    Aabb::new(lo, hi)
-}
-
 impl Scene {
     /// An empty scene.
     pub fn new() -> Scene {
@@ -82,11 +76,11 @@ impl Scene {
 
     /// Adds a thin surface whose cells are given in the object's frame, placed at `pose` in the
     /// world. Returns the object's index.
-    pub fn add_surface(&mut self, name: impl Into<String>, pose: Pose, area: ThicknessArea) -> usize {
-        let aabbs: Vec<Aabb> = area.cells.iter().map(cell_aabb).collect();
-        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs);
-        let world_aabb = if aabbs.is_empty() { Aabb::new_invalid() } else { transformed_aabb(&bvh.root_aabb(), &pose) };
-        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Surface { area, bvh }, world_aabb });
+    /// The area's cells are reordered for the broad phase (see [`CellTree::build`]).
+    pub fn add_surface(&mut self, name: impl Into<String>, pose: Pose, mut area: ThicknessArea) -> usize {
+        let tree = CellTree::build(&mut area.cells);
+        let world_aabb = if tree.is_empty() { Aabb::new_invalid() } else { transformed_aabb(&tree.root_aabb(), &pose) };
+        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Surface { area, tree }, world_aabb });
         self.objects.len() - 1
     }
 
@@ -132,15 +126,13 @@ impl Scene {
         let nan = Vector::splat(Real::NAN);
         let rot = target.pose.rotation;
         let mut deepest: Option<Contact> = None;
-        // Candidates that the normal axis does not separate: (depth if colliding, cell index).
-        let mut survivors: Vec<(Real, u32, Vector)> = Vec::new();
         let target_aabb = target.aabb_in(&target.pose);
         for (oi, object) in self.objects.iter().enumerate() {
             if !check(oi) || !object.world_aabb.intersects(&target_aabb) {
                 continue;
             }
-            let (area, bvh) = match &object.body {
-                ObjectBody::Surface { area, bvh } => (area, bvh),
+            let (area, tree) = match &object.body {
+                ObjectBody::Surface { area, tree } => (area, tree),
                 ObjectBody::Solid(shape) => {
                     // Bounding boxes first: GJK costs ~2 us, and most links are nowhere near.
                     let target_in_object = object.pose.inv_mul(&target.pose);
@@ -163,51 +155,50 @@ impl Scene {
                     continue;
                 }
             };
-            let target_in_object = object.pose.inv_mul(&target.pose);
-            let object_in_target = target_in_object.inverse();
-            let aabb = target.aabb_in(&target_in_object);
+            if tree.is_empty() {
+                continue;
+            }
+            let view = TargetView::new(target, &object.pose, area.side);
+            let pos12 = view.object_in_target;
             let side = area.side;
-            survivors.clear();
             let mut hint = [u32::MAX; 2];
-            for leaf in bvh.intersect_aabb(&aabb) {
-                report.candidates += 1;
-                if let Some((push, depth)) = normal_axis(target, &area.cells[leaf as usize], side, &object_in_target, &mut hint) {
-                    if settings.flag_only {
-                        // A yes/no question: the first cell that collides answers it.
-                        let cell = &area.cells[leaf as usize];
-                        if let Some(sat) = LocalPair::new(target, cell, &object_in_target).sat() {
-                            let nan = Vector::splat(Real::NAN);
-                            report.objects.push(oi);
-                            report.contacts.push(Contact { object: oi, triangle: cell.triangle, depth, normal: target.pose.rotation * push, position: nan, overlap: sat.overlap, axis: target.pose.rotation * sat.axis });
-                            return report;
-                        }
+            let mut separating = Vector::ZERO;
+            let mut hit_object = false;
+            if settings.flag_only || settings.all_contacts {
+                // Every cell that can meet the target, depth first through the tree.
+                let mut stack = vec![0u32];
+                while let Some(node) = stack.pop() {
+                    if tree.bound(node, &view, &mut hint).is_none() {
                         continue;
                     }
-                    survivors.push((depth, leaf, push));
-                }
-            }
-            if !settings.all_contacts {
-                // Deepest first: the first colliding cell is this object's deepest contact, and
-                // cells shallower than the deepest found so far need no SAT once the object is
-                // known to collide. On a link pushed through a wall this skips ~99% of the SATs.
-                survivors.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
-            }
-            let mut hit_object = false;
-            for &(depth, leaf, push) in &survivors {
-                let cell = &area.cells[leaf as usize];
-                let pair = LocalPair::new(target, cell, &object_in_target);
-                let Some(sat) = pair.sat() else { continue };
-                hit_object = true;
-                let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: nan, overlap: sat.overlap, axis: rot * sat.axis };
-                if settings.all_contacts {
-                    contact.position = pair.point(push).map_or(nan, |p| target.pose * p);
-                    report.contacts.push(contact);
-                } else {
-                    if deepest.as_ref().map_or(true, |d| depth > d.depth) {
-                        contact.position = pair.point(push).map_or(nan, |p| target.pose * p);
-                        deepest = Some(contact);
+                    if let Some([left, right]) = tree.children(node) {
+                        stack.extend([right, left]);
+                        continue;
                     }
-                    break;
+                    for slab in tree.leaf_cells(node) {
+                        report.candidates += 1;
+                        let Some((push, depth)) = normal_axis(target, slab, side, &pos12, &mut hint) else { continue };
+                        let cell = &area.cells[slab.cell as usize];
+                        let pair = LocalPair::new(target, cell, &pos12);
+                        let Some(sat) = pair.sat_cached(&mut separating) else { continue };
+                        hit_object = true;
+                        let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: nan, overlap: sat.overlap, axis: rot * sat.axis };
+                        if settings.flag_only {
+                            // A yes/no question: the first cell that collides answers it.
+                            report.objects.push(oi);
+                            report.contacts.push(contact);
+                            return report;
+                        }
+                        contact.position = pair.point(push).map_or(nan, |p| target.pose * p);
+                        report.contacts.push(contact);
+                    }
+                }
+            } else if let Some((depth, leaf, push, sat)) = deepest_cell(tree, area, &view, &mut hint, &mut report.candidates) {
+                hit_object = true;
+                if deepest.as_ref().map_or(true, |d| depth > d.depth) {
+                    let cell = &area.cells[leaf as usize];
+                    let position = LocalPair::new(target, cell, &pos12).point(push).map_or(nan, |p| target.pose * p);
+                    deepest = Some(Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position, overlap: sat.overlap, axis: rot * sat.axis });
                 }
             }
             if hit_object {
@@ -240,4 +231,113 @@ fn collide_solid(target: &Target, object: usize, object_pose: &Pose, shape: &Tar
     }
     let normal = -c.normal1;
     Some(Contact { object, triangle: u32::MAX, depth: -c.dist, normal, position: (c.point1 + c.point2) * 0.5, overlap: -c.dist, axis: normal })
+}
+
+/// How much deeper than the deepest contact found a subtree's bound must be to be searched: the
+/// reported contact is the deepest to within this (metres), and flat patches, whose bound equals
+/// their depth up to rounding, are not searched again and again.
+const DEPTH_TOLERANCE: Real = 1e-9;
+
+/// A node of the best-first search, ordered by its bound.
+struct Pending(Real, u32);
+
+impl PartialEq for Pending {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.total_cmp(&other.0).is_eq()
+    }
+}
+impl Eq for Pending {}
+impl PartialOrd for Pending {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Pending {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+/// The deepest colliding cell of one surface: `(depth, cell index, push-out normal, SAT result)`
+/// in the target's frame. Best first: subtrees are searched in the order of their depth bounds,
+/// and the search ends when no bound beats the deepest collision found. Pairs are decided by
+/// [`quick_decide`] where it can, and the winner is confirmed by the full SAT, which also gives
+/// its least overlap.
+fn deepest_cell(tree: &CellTree, area: &ThicknessArea, view: &TargetView, hint: &mut [u32; 2], candidates: &mut usize) -> Option<(Real, u32, Vector, SatOverlap)> {
+    let (depth, leaf, push) = deepest_search(tree, area, view, hint, candidates, true)?;
+    let pair = LocalPair::new(view.target, &area.cells[leaf as usize], &view.object_in_target);
+    if let Some(sat) = pair.sat() {
+        return Some((depth, leaf, push, sat));
+    }
+    // The centroid test and the SAT disagreed (rounding on a razor-thin overlap): search again
+    // with the SAT alone deciding.
+    let (depth, leaf, push) = deepest_search(tree, area, view, hint, candidates, false)?;
+    let sat = LocalPair::new(view.target, &area.cells[leaf as usize], &view.object_in_target).sat()?;
+    Some((depth, leaf, push, sat))
+}
+
+fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, hint: &mut [u32; 2], candidates: &mut usize, quick: bool) -> Option<(Real, u32, Vector)> {
+    let mut best: Option<(Real, u32, Vector)> = None;
+    let mut best_depth = Real::NEG_INFINITY;
+    let mut heap = std::collections::BinaryHeap::with_capacity(64);
+    if let Some(b) = tree.bound(0, view, hint) {
+        heap.push(Pending(b, 0));
+    }
+    let mut leaf_hits: Vec<(Real, u32, Vector)> = Vec::with_capacity(8);
+    let mut recent = RecentAxes::default();
+    while let Some(Pending(bound, node)) = heap.pop() {
+        if bound <= best_depth + DEPTH_TOLERANCE {
+            break;
+        }
+        if let Some(children) = tree.children(node) {
+            for child in children {
+                let (centre, half) = tree.node_box(child);
+                if recent.separate_box(centre, half) {
+                    continue;
+                }
+                if let Some(b) = tree.bound(child, view, hint) {
+                    if b > best_depth + DEPTH_TOLERANCE {
+                        heap.push(Pending(b, child));
+                    }
+                }
+            }
+            continue;
+        }
+        leaf_hits.clear();
+        for slab in tree.leaf_cells(node) {
+            *candidates += 1;
+            if !CellTree::slab_meets_target_box(slab, view) || recent.separate_box(slab.centre, slab.half) {
+                continue;
+            }
+            if let Some((push, depth)) = normal_axis_deeper(view.target, slab, area.side, &view.rotation, view.object_in_target.translation, hint, best_depth + DEPTH_TOLERANCE) {
+                leaf_hits.push((depth, slab.cell, push));
+            }
+        }
+        // Deepest first: the first that collides is the leaf's deepest contact. Picked one by
+        // one, as the first pick usually settles the leaf.
+        while let Some(k) = (0..leaf_hits.len()).max_by(|&a, &b| leaf_hits[a].0.total_cmp(&leaf_hits[b].0)) {
+            let (depth, leaf, push) = leaf_hits.swap_remove(k);
+            let cell = &area.cells[leaf as usize];
+            let quick_answer = if quick { quick_decide(view, cell, &mut recent) } else { None };
+            let hit = match quick_answer {
+                Some(hit) => hit,
+                None => {
+                    let mut separating = Vector::ZERO;
+                    let hit = LocalPair::new(view.target, cell, &view.object_in_target).sat_cached(&mut separating).is_some();
+                    if separating != Vector::ZERO {
+                        // The SAT's axis is in the target's frame.
+                        let axis = view.object_in_target.rotation.inverse() * separating;
+                        recent.remember(axis, view.extent_along(axis));
+                    }
+                    hit
+                }
+            };
+            if hit {
+                best = Some((depth, leaf, push));
+                best_depth = depth;
+                break;
+            }
+        }
+    }
+    best
 }

@@ -22,6 +22,8 @@ pub(crate) struct HullEdge {
     pub dir: Vector,
     pub n1: Vector,
     pub n2: Vector,
+    /// `n2 x n1`: the normal of the edge's arc on the Gauss map.
+    pub arc: Vector,
 }
 
 /// A convex polytope in its own frame, with what the separating-axis test needs precomputed.
@@ -31,17 +33,92 @@ pub struct ConvexHull {
     pub(crate) faces: Vec<HullFace>,
     pub(crate) edges: Vec<HullEdge>,
     pub(crate) centroid: Vector,
+    /// `max |x - centroid|` over the vertices.
+    pub(crate) radius: Real,
     pub(crate) aabb: Aabb,
+    /// The face normals, `min` and `max` again as arrays (padded to a multiple of `LANES` with
+    /// faces that never separate) and the edges' face normals likewise, for the SAT's loops over
+    /// every face and edge, which the compiler vectorises in this layout.
+    pub(crate) face_soa: [Vec<Real>; 5],
+    pub(crate) edge_soa: [Vec<Real>; 6],
     /// Vertex adjacency (CSR: the neighbours of `i` are `adjacent[first[i]..first[i + 1]]`).
     adjacency_first: Vec<u32>,
     adjacency: Vec<u32>,
-    /// The vertex extreme along +x, -x, +y, -y, +z, -z: where hill climbing starts.
-    extreme: [u32; 6],
+    /// For each bin of a cube map over directions (see `start_bin`): the vertex extreme along
+    /// every direction of the bin, flagged with `EXACT`, when one vertex is (then no climb is
+    /// needed); else the vertex extreme along the bin's centre, where climbing starts.
+    starts: Vec<u32>,
     parry: ConvexPolyhedron,
 }
 
+/// Chunk width of the SAT's vectorised loops.
+pub(crate) const LANES: usize = 8;
+
 /// Below this many vertices a linear scan beats hill climbing.
 const CLIMB_MIN_POINTS: usize = 24;
+
+/// Bins per side of each face of the cube map of climb starts.
+const START_BINS: usize = 32;
+
+/// Flags a cube-map bin whose every direction has the same extreme vertex.
+const EXACT: u32 = 1 << 31;
+
+/// The cube-map bin of a direction: the face of its largest coordinate, then the two others
+/// divided by it, binned.
+#[inline]
+fn start_bin(dir: Vector) -> usize {
+    let a = dir.abs();
+    let (k, u, v) = if a.x >= a.y && a.x >= a.z { (0, dir.y, dir.z) } else if a.y >= a.z { (1, dir.z, dir.x) } else { (2, dir.x, dir.y) };
+    let m = a[k];
+    let face = 2 * k + (dir[k] < 0.0) as usize;
+    let cell = |t: Real| (((t / m + 1.0) * 0.5 * START_BINS as Real) as usize).min(START_BINS - 1);
+    (face * START_BINS + cell(u)) * START_BINS + cell(v)
+}
+
+/// The direction through point `(u, v)` (each in `[-1, 1]`) of a cube-map face (not normalised).
+fn cube_direction(face: usize, u: Real, v: Real) -> Vector {
+    let s = if face % 2 == 0 { 1.0 } else { -1.0 };
+    match face / 2 {
+        0 => Vector::new(s, u, v),
+        1 => Vector::new(v, s, u),
+        _ => Vector::new(u, v, s),
+    }
+}
+
+/// The cube map of [`ConvexHull::starts`]. A bin's directions are the positive combinations of
+/// its four corner directions, and the directions along which a vertex is extreme form a convex
+/// cone: when one vertex is the unique extreme at all four corners, it is at every direction of
+/// the bin.
+fn support_cube_map(points: &[Vector]) -> Vec<u32> {
+    let n = START_BINS;
+    let grid = |i: usize| i as Real / n as Real * 2.0 - 1.0;
+    // The extreme vertex along `dir`, and whether it is unique (by more than rounding).
+    let extreme = |dir: Vector| {
+        let (mut best, mut second, mut at) = (Real::NEG_INFINITY, Real::NEG_INFINITY, 0);
+        for (i, p) in points.iter().enumerate() {
+            let d = dir.dot(*p);
+            if d > best {
+                (second, best, at) = (best, d, i);
+            } else if d > second {
+                second = d;
+            }
+        }
+        (at as u32, best - second > 1e-12 * (1.0 + best.abs()))
+    };
+    let mut starts = Vec::with_capacity(6 * n * n);
+    for face in 0..6 {
+        let corners: Vec<(u32, bool)> = (0..=n).flat_map(|i| (0..=n).map(move |j| (i, j))).map(|(i, j)| extreme(cube_direction(face, grid(i), grid(j)))).collect();
+        for i in 0..n {
+            for j in 0..n {
+                let c = [corners[i * (n + 1) + j], corners[i * (n + 1) + j + 1], corners[(i + 1) * (n + 1) + j], corners[(i + 1) * (n + 1) + j + 1]];
+                let exact = c.iter().all(|&(v, unique)| unique && v == c[0].0);
+                let centre = (grid(i) + grid(i + 1)) * 0.5;
+                starts.push(if exact { c[0].0 | EXACT } else { extreme(cube_direction(face, centre, (grid(j) + grid(j + 1)) * 0.5)).0 });
+            }
+        }
+    }
+    starts
+}
 
 impl ConvexHull {
     /// The convex hull of `points` (at least 4 points not in one plane), with coplanar faces merged.
@@ -93,7 +170,8 @@ impl ConvexHull {
                 return None; // not a closed polytope
             }
             let (pa, pb) = (points[a as usize], points[b as usize]);
-            edges.push(HullEdge { point: pa, dir: (pb - pa).normalize(), n1: faces[fs[0]].normal, n2: faces[fs[1]].normal });
+            let (n1, n2) = (faces[fs[0]].normal, faces[fs[1]].normal);
+            edges.push(HullEdge { point: pa, dir: (pb - pa).normalize(), n1, n2, arc: n2.cross(n1) });
             neighbours[a as usize].push(b);
             neighbours[b as usize].push(a);
         }
@@ -106,12 +184,31 @@ impl ConvexHull {
             adjacency.extend_from_slice(n);
             adjacency_first[i + 1] = adjacency.len() as u32;
         }
-        let mut extreme = [0u32; 6];
-        for (k, dir) in [Vector::X, -Vector::X, Vector::Y, -Vector::Y, Vector::Z, -Vector::Z].into_iter().enumerate() {
-            let best = (0..points.len()).max_by(|&i, &j| dir.dot(points[i]).total_cmp(&dir.dot(points[j])));
-            extreme[k] = best.unwrap_or(0) as u32;
+        let pad = |n: usize| n.div_ceil(LANES) * LANES;
+        let mut face_soa: [Vec<Real>; 5] = std::array::from_fn(|_| vec![0.0; pad(faces.len())]);
+        for (i, f) in faces.iter().enumerate() {
+            for k in 0..3 {
+                face_soa[k][i] = f.normal[k];
+            }
+            face_soa[3][i] = f.min;
+            face_soa[4][i] = f.max;
         }
-        Some(ConvexHull { points, faces, edges, centroid, aabb: Aabb::new(lo, hi), adjacency_first, adjacency, extreme, parry })
+        // Padding faces: normal 0, range [-inf, inf], which overlaps everything.
+        for i in faces.len()..pad(faces.len()) {
+            face_soa[3][i] = Real::NEG_INFINITY;
+            face_soa[4][i] = Real::INFINITY;
+        }
+        // Padding edges: zero normals, which never pass the Gauss-map test (0 * 0 < 0 is false).
+        let mut edge_soa: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; pad(edges.len())]);
+        for (i, e) in edges.iter().enumerate() {
+            for k in 0..3 {
+                edge_soa[k][i] = e.n1[k];
+                edge_soa[3 + k][i] = e.n2[k];
+            }
+        }
+        let starts = if points.len() >= CLIMB_MIN_POINTS { support_cube_map(&points) } else { Vec::new() };
+        let radius = points.iter().map(|p| (*p - centroid).length()).fold(0.0, Real::max);
+        Some(ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), face_soa, edge_soa, adjacency_first, adjacency, starts, parry })
     }
 
     /// The hull grown by `padding` metres: every vertex moved out along the normal of each of its
@@ -160,23 +257,21 @@ impl ConvexHull {
 
 impl ConvexHull {
     /// `max dir . x` by hill climbing over the vertex graph: on a convex polytope a vertex no
-    /// neighbour improves on is the global maximum. Starts at the extreme vertex of the closest
-    /// coordinate axis; on a ~100-vertex link hull that visits ~5 vertices instead of 100.
+    /// neighbour improves on is the global maximum. Starts at the vertex extreme along the centre
+    /// of `dir`'s cube-map bin, one or two steps from the answer.
     fn climb(&self, dir: Vector) -> Real {
         self.climb_from(dir, u32::MAX).0
     }
 
-    /// Hill climbing from vertex `start` (`u32::MAX`: the extreme vertex of the closest axis);
-    /// returns the maximum and the vertex where it is reached, the start for a nearby direction.
+    /// `max dir . x` and the vertex where it is reached: looked up in the cube map where that
+    /// answers it, else by hill climbing from vertex `start` (`u32::MAX`: the cube map's start).
     fn climb_from(&self, dir: Vector, start: u32) -> (Real, u32) {
-        let mut at = if (start as usize) < self.points.len() {
-            start as usize
-        } else {
-            let a = dir.abs();
-            let k = if a.x >= a.y && a.x >= a.z { 0 } else if a.y >= a.z { 2 } else { 4 };
-            let k = k + (dir[k / 2] < 0.0) as usize;
-            self.extreme[k] as usize
-        };
+        let entry = self.starts[start_bin(dir)];
+        if entry & EXACT != 0 {
+            let at = entry & !EXACT;
+            return (dir.dot(self.points[at as usize]), at);
+        }
+        let mut at = if (start as usize) < self.points.len() { start as usize } else { entry as usize };
         let mut best = dir.dot(self.points[at]);
         loop {
             let mut moved = false;
@@ -258,6 +353,20 @@ impl TargetShape {
         }
     }
 
+    /// `max dir . x` over the shape, a hull's climb starting at `hint` (`u32::MAX`: none), which
+    /// is then set to where the maximum is.
+    #[inline]
+    pub(crate) fn support_hinted(&self, dir: Vector, hint: &mut u32) -> Real {
+        match self {
+            TargetShape::Polytope(h) if h.points.len() >= CLIMB_MIN_POINTS => {
+                let (value, at) = h.climb_from(dir, *hint);
+                *hint = at;
+                value
+            }
+            _ => self.project(dir)[1],
+        }
+    }
+
     /// `[min, max]` of `dir . x` over the shape (in its frame).
     #[inline]
     pub(crate) fn project(&self, dir: Vector) -> [Real; 2] {
@@ -275,6 +384,29 @@ impl TargetShape {
         match self {
             TargetShape::Polytope(h) => h.centroid,
             _ => Vector::ZERO,
+        }
+    }
+
+    /// Whether `p` (in the shape's frame) lies inside the shape, at least `margin` from its boundary.
+    pub(crate) fn contains_strictly(&self, p: Vector, margin: Real) -> bool {
+        match self {
+            TargetShape::Polytope(h) => h.aabb.mins.cmplt(p).all() && p.cmplt(h.aabb.maxs).all() && h.faces.iter().all(|f| f.normal.dot(p) < f.max - margin),
+            TargetShape::Sphere { radius } => p.length() < radius - margin,
+            TargetShape::Capsule { half_height, radius } => {
+                let z = p.z.clamp(-half_height, *half_height);
+                (p - Vector::new(0.0, 0.0, z)).length() < radius - margin
+            }
+            TargetShape::Cylinder { half_height, radius } => p.z.abs() < half_height - margin && p.x.hypot(p.y) < radius - margin,
+        }
+    }
+
+    /// The radius of a ball about [`TargetShape::centre`] that holds the shape.
+    pub(crate) fn bounding_radius(&self) -> Real {
+        match self {
+            TargetShape::Polytope(h) => h.radius,
+            TargetShape::Sphere { radius } => *radius,
+            TargetShape::Capsule { half_height, radius } => half_height + radius,
+            TargetShape::Cylinder { half_height, radius } => half_height.hypot(*radius),
         }
     }
 
@@ -336,3 +468,4 @@ impl Target {
         Aabb::new(lo + pos.translation, hi + pos.translation)
     }
 }
+

@@ -17,3 +17,19 @@ pub(crate) fn is_minkowski_face(a: Vector, b: Vector, c: Vector, d: Vector) -> b
     let bdc = b.dot(dxc);
     cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0
 }
+
+/// [`is_minkowski_face`] with the arcs' normals given (`bxa = b x a`, `dxc = d x c`), for loops
+/// that test one edge against many: the cheap half of the test comes first, and most pairs stop
+/// there.
+#[inline]
+pub(crate) fn is_minkowski_face_arcs(a: Vector, b: Vector, bxa: Vector, c: Vector, d: Vector, dxc: Vector) -> bool {
+    let adc = a.dot(dxc);
+    let bdc = b.dot(dxc);
+    if !(adc * bdc < 0.0) {
+        return false;
+    }
+    // With the second edge's normals negated: cba = -c . bxa, dba = -d . bxa.
+    let cba = -c.dot(bxa);
+    let dba = -d.dot(bxa);
+    cba * dba < 0.0 && cba * bdc > 0.0
+}

@@ -1,0 +1,330 @@
+//! The broad phase over one thin surface's cells: a bounding-volume tree whose nodes also bound
+//! the cells' normals, so a query for the deepest contact can skip whole subtrees.
+//!
+//! Why not parry's BVH alone: the deepest contact of a link pushed through a wall is the maximum
+//! over every cell under the link's bounding box (thousands at 1M triangles), and an AABB tree can
+//! only hand them all over. Each node here also carries a cone around its cells' normals and the
+//! slab the cells occupy along the cone's axis; from those follow an upper bound on the depth any
+//! of its cells can report (see [`CellTree::bound`]), and a best-first search stops as soon as
+//! no bound beats the deepest contact found. Where a surface is flat the bound is exact, and one
+//! leaf answers for the whole plane.
+
+use super::target::Target;
+use crate::math::{Aabb, Pose, Real, Vector};
+use parry3d_f64::math::Matrix;
+use crate::thickness::{Side, ThicknessCell};
+
+/// Cells per leaf.
+const LEAF_CELLS: usize = 16;
+
+/// Slack when a node's slab is compared with the target: rounding must never prune a node whose
+/// cells the exact per-cell test would keep.
+const SLAB_SLACK: Real = 1e-10;
+
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CellNode {
+    lo: Vector,
+    hi: Vector,
+    /// Unit axis of the cone around the cells' face normals.
+    axis: Vector,
+    /// Every cell normal `n` has `|n - axis| <= spread` (so 0 for a flat patch).
+    spread: Real,
+    /// `max axis . v` over the cells' vertices (an upper bound above the leaves).
+    top: Real,
+    /// `min axis . v` over the cells' vertices (a lower bound above the leaves).
+    bottom: Real,
+    /// Half the diagonal of the box.
+    radius: Real,
+    /// A leaf: the first index into `slabs`; an inner node: the index of its right child (the
+    /// left child follows the node).
+    first: u32,
+    /// Cells in a leaf; 0 for an inner node.
+    count: u32,
+}
+
+impl CellNode {
+    fn centre(&self) -> Vector {
+        (self.lo + self.hi) * 0.5
+    }
+}
+
+/// What the cheap first test of a cell (its normal axis) reads, kept beside the tree in leaf
+/// order: a leaf's cells are then one contiguous read, where the cells themselves (328 bytes
+/// each, in input order) would cost a cache miss each on a large surface.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CellSlab {
+    /// The face's front normal.
+    pub normal: Vector,
+    /// `[min, max]` of `normal . x` over the cell.
+    pub range: [Real; 2],
+    /// `normal . x` on the face.
+    pub plane_offset: Real,
+    /// Index of the cell in its area.
+    pub cell: u32,
+    /// The centre and half extents of the cell's bounding box.
+    pub centre: Vector,
+    pub half: Vector,
+}
+
+impl CellSlab {
+    pub fn of(cell: &ThicknessCell, index: u32) -> CellSlab {
+        let (lo, hi) = cell_box(cell);
+        CellSlab { normal: cell.normal, range: cell.normal_range(), plane_offset: cell.plane_offset, cell: index, centre: (lo + hi) * 0.5, half: (hi - lo) * 0.5 }
+    }
+}
+
+/// The tree over one surface's cells, in the surface's frame.
+#[derive(Clone, Debug, Default)]
+pub struct CellTree {
+    nodes: Vec<CellNode>,
+    /// The cells' normal slabs in leaf order.
+    slabs: Vec<CellSlab>,
+}
+
+/// A target seen from a surface's frame, with what the node tests need.
+pub(crate) struct TargetView<'a> {
+    pub target: &'a Target,
+    /// The pose of the surface's frame in the target's frame.
+    pub object_in_target: Pose,
+    /// The target's bounding box in the surface's frame.
+    pub aabb: Aabb,
+    /// The target's bounding box in its own frame, and the rotation part of `object_in_target`
+    /// as a matrix and with its entries made positive: a node's box seen from the target.
+    local_aabb: Aabb,
+    pub rotation: Matrix,
+    rotation_abs: Matrix,
+    /// The target's centre in the surface's frame.
+    pub centre: Vector,
+    /// Radius of a ball about `centre` that holds the target.
+    radius: Real,
+    side: Side,
+}
+
+impl<'a> TargetView<'a> {
+    pub fn new(target: &'a Target, object_pose: &Pose, side: Side) -> Self {
+        let target_in_object = object_pose.inv_mul(&target.pose);
+        let object_in_target = target_in_object.inverse();
+        let rotation = Matrix::from_quat(object_in_target.rotation);
+        TargetView {
+            target,
+            object_in_target,
+            local_aabb: target.shape.local_aabb(),
+            rotation,
+            rotation_abs: rotation.abs(),
+            aabb: target.aabb_in(&target_in_object),
+            centre: target_in_object * target.shape.centre(),
+            radius: target.shape.bounding_radius(),
+            side,
+        }
+    }
+
+    /// `[min, max]` of `dir . x` over the target (surface frame), without warm start.
+    pub fn extent_along(&self, dir: Vector) -> [Real; 2] {
+        let d = self.rotation * dir;
+        let shift = d.dot(self.object_in_target.translation);
+        self.target.shape.project(d).map(|x| x - shift)
+    }
+
+    /// `[min, max]` of `dir . x` over the target, for a direction in the surface's frame.
+    #[inline]
+    fn project(&self, dir: Vector, hint: &mut [u32; 2]) -> [Real; 2] {
+        let d = self.rotation * dir;
+        let shift = d.dot(self.object_in_target.translation);
+        self.target.shape.project_hinted(d, hint).map(|x| x - shift)
+    }
+}
+
+fn cell_box(cell: &ThicknessCell) -> (Vector, Vector) {
+    let v = cell.vertices();
+    v.iter().fold((v[0], v[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+}
+
+/// `max dir . x` over a box.
+fn box_support(lo: Vector, hi: Vector, dir: Vector) -> Real {
+    let c = (lo + hi) * 0.5;
+    let h = (hi - lo) * 0.5;
+    dir.dot(c) + dir.abs().dot(h)
+}
+
+fn unit_or(v: Vector, fallback: Vector) -> Vector {
+    let l = v.length();
+    if l > 1e-12 && l.is_finite() {
+        v / l
+    } else {
+        fallback
+    }
+}
+
+struct Builder<'a> {
+    cells: &'a [ThicknessCell],
+    boxes: Vec<(Vector, Vector)>,
+    centres: Vec<Vector>,
+    nodes: Vec<CellNode>,
+    order: Vec<u32>,
+}
+
+impl Builder<'_> {
+    /// Builds the subtree over `order[start..end]`; returns its node and the sum of its normals.
+    fn build(&mut self, start: usize, end: usize) -> (usize, Vector) {
+        let at = self.nodes.len();
+        self.nodes.push(CellNode { lo: Vector::ZERO, hi: Vector::ZERO, axis: Vector::Z, spread: 0.0, top: 0.0, bottom: 0.0, radius: 0.0, first: 0, count: 0 });
+        if end - start <= LEAF_CELLS {
+            let ids = &self.order[start..end];
+            let (mut lo, mut hi) = self.boxes[ids[0] as usize];
+            let mut sum = Vector::ZERO;
+            for &i in ids {
+                let (l, h) = self.boxes[i as usize];
+                lo = lo.min(l);
+                hi = hi.max(h);
+                sum += self.cells[i as usize].normal;
+            }
+            let axis = unit_or(sum, self.cells[ids[0] as usize].normal);
+            let (mut spread, mut top, mut bottom) = (0.0 as Real, Real::NEG_INFINITY, Real::INFINITY);
+            for &i in ids {
+                let cell = &self.cells[i as usize];
+                spread = spread.max((cell.normal - axis).length());
+                for v in cell.vertices() {
+                    let d = axis.dot(v);
+                    top = top.max(d);
+                    bottom = bottom.min(d);
+                }
+            }
+            self.nodes[at] = CellNode { lo, hi, axis, spread, top, bottom, radius: (hi - lo).length() * 0.5, first: start as u32, count: (end - start) as u32 };
+            return (at, sum);
+        }
+        // Median split on the longest axis of the cells' centres.
+        let (clo, chi) = self.order[start..end].iter().fold((Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY)), |(lo, hi), &i| {
+            let c = self.centres[i as usize];
+            (lo.min(c), hi.max(c))
+        });
+        let ext = chi - clo;
+        let k = if ext.x >= ext.y && ext.x >= ext.z { 0 } else if ext.y >= ext.z { 1 } else { 2 };
+        let mid = (end - start) / 2;
+        let centres = &self.centres;
+        let _ = self.order[start..end].select_nth_unstable_by(mid, |a, b| centres[*a as usize][k].total_cmp(&centres[*b as usize][k]));
+        let (left, sum_l) = self.build(start, start + mid);
+        let (right, sum_r) = self.build(start + mid, end);
+        let (l, r) = (self.nodes[left], self.nodes[right]);
+        let sum = sum_l + sum_r;
+        let axis = unit_or(sum, l.axis);
+        let (lo, hi) = (l.lo.min(r.lo), l.hi.max(r.hi));
+        let mut spread: Real = 0.0;
+        let mut top = Real::NEG_INFINITY;
+        let mut bottom = Real::INFINITY;
+        for c in [l, r] {
+            // Each child's cells: `axis . v = c.axis . v + (axis - c.axis) . v`, and `v` lies in
+            // the child's box, within `c.radius` of its centre.
+            let tilt = (axis - c.axis).length();
+            spread = spread.max(tilt + c.spread);
+            let moved = (axis - c.axis).dot(c.centre());
+            top = top.max(c.top + moved + tilt * c.radius);
+            bottom = bottom.min(c.bottom + moved - tilt * c.radius);
+        }
+        top = top.min(box_support(lo, hi, axis));
+        bottom = bottom.max(-box_support(lo, hi, -axis));
+        self.nodes[at] = CellNode { lo, hi, axis, spread: spread.min(2.0), top, bottom, radius: (hi - lo).length() * 0.5, first: right as u32, count: 0 };
+        (at, sum)
+    }
+}
+
+impl CellTree {
+    /// The tree over `cells` (given in the surface's frame), which are put in the tree's leaf
+    /// order: the cells a query decides lie next to each other in memory (on a 1M-triangle
+    /// surface, input order cost a cache miss per cell). Each cell keeps its `triangle`.
+    pub fn build(cells: &mut Vec<ThicknessCell>) -> CellTree {
+        if cells.is_empty() {
+            return CellTree::default();
+        }
+        let boxes: Vec<(Vector, Vector)> = cells.iter().map(cell_box).collect();
+        let centres = boxes.iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
+        let mut b = Builder { cells, boxes, centres, nodes: Vec::with_capacity(2 * cells.len() / LEAF_CELLS + 2), order: (0..cells.len() as u32).collect() };
+        let _ = b.build(0, cells.len());
+        let (nodes, order) = (b.nodes, b.order);
+        let sorted: Vec<ThicknessCell> = order.iter().map(|&i| cells[i as usize].clone()).collect();
+        *cells = sorted;
+        let slabs = cells.iter().enumerate().map(|(k, c)| CellSlab::of(c, k as u32)).collect();
+        CellTree { nodes, slabs }
+    }
+
+    /// The box around every cell (invalid when there are none).
+    pub fn root_aabb(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::new_invalid(), |n| Aabb::new(n.lo, n.hi))
+    }
+
+    /// Bytes held by the tree.
+    pub fn memory(&self) -> usize {
+        std::mem::size_of::<Self>() + self.nodes.capacity() * std::mem::size_of::<CellNode>() + self.slabs.capacity() * std::mem::size_of::<CellSlab>()
+    }
+
+    pub(crate) fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The cells of a leaf (empty for an inner node).
+    #[inline]
+    pub(crate) fn leaf_cells(&self, node: u32) -> &[CellSlab] {
+        let n = &self.nodes[node as usize];
+        &self.slabs[n.first as usize..(n.first + n.count) as usize]
+    }
+
+    /// The centre and half extents of a node's box.
+    #[inline]
+    pub(crate) fn node_box(&self, node: u32) -> (Vector, Vector) {
+        let n = &self.nodes[node as usize];
+        (n.centre(), (n.hi - n.lo) * 0.5)
+    }
+
+    /// The children of an inner node; `None` for a leaf.
+    #[inline]
+    pub(crate) fn children(&self, node: u32) -> Option<[u32; 2]> {
+        let n = &self.nodes[node as usize];
+        (n.count == 0).then(|| [node + 1, n.first])
+    }
+
+    /// Whether a cell's box, seen from the target's frame, meets the target's own box.
+    #[inline]
+    pub(crate) fn slab_meets_target_box(slab: &CellSlab, view: &TargetView) -> bool {
+        let c = view.rotation * slab.centre + view.object_in_target.translation;
+        let h = view.rotation_abs * slab.half;
+        let b = &view.local_aabb;
+        (c - h).cmple(b.maxs).all() && b.mins.cmple(c + h).all()
+    }
+
+    /// `None` when no cell of `node` can meet the target (its box misses the target's box, or the
+    /// slab the cells fill along the cone axis misses the target's extent on that axis). Else an
+    /// upper bound on the depth any of its cells reports.
+    ///
+    /// The bound, for a `back` cell with normal `n`, whose depth is `max n . (q - x)` over `q` in
+    /// the cell and `x` in the target: with `m` the cone axis, `o` the box centre and `c` the
+    /// target's centre, `n . (q - x) = m . q - m . x + (n - m) . (q - o) + (n - m) . (o - x)`,
+    /// hence `depth <= top - min(m . x) + spread * (radius + |o - c| + target radius)`. A `front`
+    /// cell is the mirror image (`max(m . x) - bottom`); a `both` cell takes the larger.
+    #[inline]
+    pub(crate) fn bound(&self, node: u32, view: &TargetView, hint: &mut [u32; 2]) -> Option<Real> {
+        let n = &self.nodes[node as usize];
+        let a = &view.aabb;
+        if n.lo.x > a.maxs.x || n.lo.y > a.maxs.y || n.lo.z > a.maxs.z || n.hi.x < a.mins.x || n.hi.y < a.mins.y || n.hi.z < a.mins.z {
+            return None;
+        }
+        // The node's box seen from the target's frame, against the target's own box: for a
+        // link tilted across a surface this drops most of what its world box takes in.
+        let centre = view.rotation * n.centre() + view.object_in_target.translation;
+        let half = view.rotation_abs * ((n.hi - n.lo) * 0.5);
+        let (t_lo, t_hi) = (centre - half, centre + half);
+        let b = &view.local_aabb;
+        if t_lo.x > b.maxs.x || t_lo.y > b.maxs.y || t_lo.z > b.maxs.z || t_hi.x < b.mins.x || t_hi.y < b.mins.y || t_hi.z < b.mins.z {
+            return None;
+        }
+        let [a_min, a_max] = view.project(n.axis, hint);
+        if a_max < n.bottom - SLAB_SLACK || a_min > n.top + SLAB_SLACK || !(a_min.is_finite() && a_max.is_finite()) {
+            return None;
+        }
+        let slack = n.spread * (n.radius + (n.centre() - view.centre).length() + view.radius);
+        let depth = match view.side {
+            Side::Back => n.top - a_min,
+            Side::Front => a_max - n.bottom,
+            Side::Both => (n.top - a_min).max(a_max - n.bottom),
+        };
+        Some(depth + slack)
+    }
+}
