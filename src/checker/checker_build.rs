@@ -56,6 +56,10 @@ pub struct LinkTargets {
     pub parts: Vec<(TargetShape, Pose)>,
 }
 
+/// What a state check asks of the scene: the deepest contact of each link, without the least
+/// overlap, which a state report does not carry.
+const CHECK_SETTINGS: CollideSettings = CollideSettings { all_contacts: false, flag_only: false, least_overlap: false };
+
 /// What was loaded (printed by the CLI and the node at start).
 #[derive(Clone, Debug, Default)]
 pub struct BuildSummary {
@@ -276,7 +280,7 @@ impl Checker {
     /// Checks a joint state. Unknown names are returned for the caller to warn about (or, with
     /// `strict`, are an error); positions outside limits are flagged in the report.
     pub fn check_joints(&self, names: &[String], positions: &[f64], memory: &mut JointMemory, strict: bool) -> Result<(StateReport, Vec<String>), StateError> {
-        self.check_joints_with(names, positions, memory, strict, &CollideSettings::default())
+        self.check_joints_with(names, positions, memory, strict, &CHECK_SETTINGS)
     }
 
     /// Which links collide, and nothing more: each link stops at its first colliding cell, and
@@ -316,7 +320,7 @@ impl Checker {
             }
             world[li] = Some(Pose::from_parts(pose.translation, q.normalize()));
         }
-        let mut report = self.check_link_poses(&world, &CollideSettings::default());
+        let mut report = self.check_link_poses(&world, &CHECK_SETTINGS);
         report.check_seconds = started.elapsed().as_secs_f64();
         Ok(report)
     }

@@ -44,7 +44,8 @@ impl<'a> LocalPair<'a> {
     /// The SAT; `None` when apart.
     #[inline]
     pub fn sat(&self) -> Option<SatOverlap> {
-        self.sat_cached(&mut Vector::ZERO)
+        let mut unused = Vector::ZERO;
+        self.sat_cached(&mut unused)
     }
 
     /// The SAT, trying first an axis that separated a neighbouring cell (`Vector::ZERO`: none),
@@ -87,8 +88,8 @@ impl<'a> LocalPair<'a> {
 /// (target frame) and the depth the pair reports if it collides: the claim's `Bmax - Amin` on that
 /// axis. `pos12` is the pose of the cell's object in the target's frame.
 #[inline]
-pub(crate) fn normal_axis(target: &Target, cell: &CellSlab, side: Side, pos12: &Pose, hint: &mut [u32; 2]) -> Option<(Vector, Real)> {
-    normal_axis_deeper(target, cell, side, &Matrix::from_quat(pos12.rotation), pos12.translation, hint, Real::NEG_INFINITY)
+pub(crate) fn normal_axis(target: &Target, cell: &CellSlab, side: Side, pos12: &Pose) -> Option<(Vector, Real)> {
+    normal_axis_deeper(target, cell, side, &Matrix::from_quat(pos12.rotation), pos12.translation, Real::NEG_INFINITY)
 }
 
 /// [`normal_axis`] for a search that only wants pairs deeper than `floor`: the end of the target
@@ -96,7 +97,7 @@ pub(crate) fn normal_axis(target: &Target, cell: &CellSlab, side: Side, pos12: &
 /// climb instead of two. `rotation` and `translation` make the pose of the cell's object in the
 /// target's frame (a matrix: rotating many normals by one quaternion costs more).
 #[inline]
-pub(crate) fn normal_axis_deeper(target: &Target, cell: &CellSlab, side: Side, rotation: &Matrix, translation: Vector, hint: &mut [u32; 2], floor: Real) -> Option<(Vector, Real)> {
+pub(crate) fn normal_axis_deeper(target: &Target, cell: &CellSlab, side: Side, rotation: &Matrix, translation: Vector, floor: Real) -> Option<(Vector, Real)> {
     let n = *rotation * cell.normal;
     let shift = n.dot(translation);
     let [b_min, b_max] = cell.range.map(|x| x + shift);
@@ -108,20 +109,20 @@ pub(crate) fn normal_axis_deeper(target: &Target, cell: &CellSlab, side: Side, r
     // Apart on this axis when `a_max <= b_min` or `b_max <= a_min` (touching is apart); the
     // negated comparisons also turn a NaN into "apart".
     if front {
-        let a_min = -target.shape.support_hinted(-n, &mut hint[1]);
+        let a_min = -target.shape.support(-n);
         let depth = b_max - a_min;
         if !(depth > 0.0 && depth > floor) {
             return None;
         }
-        let a_max = target.shape.support_hinted(n, &mut hint[0]);
+        let a_max = target.shape.support(n);
         (a_max > b_min).then_some((n, depth))
     } else {
-        let a_max = target.shape.support_hinted(n, &mut hint[0]);
+        let a_max = target.shape.support(n);
         let depth = a_max - b_min;
         if !(depth > 0.0 && depth > floor) {
             return None;
         }
-        let a_min = -target.shape.support_hinted(-n, &mut hint[1]);
+        let a_min = -target.shape.support(-n);
         (b_max > a_min).then_some((-n, depth))
     }
 }
@@ -224,7 +225,7 @@ const INSIDE_MARGIN: Real = 1e-9;
 /// ```
 pub fn collide_target_cell(target: &Target, cell: &ThicknessCell, side: Side, object_pose: &Pose, want_point: bool) -> Option<CellHit> {
     let pos12 = target.pose.inv_mul(object_pose);
-    let (push, depth) = normal_axis(target, &CellSlab::of(cell, 0), side, &pos12, &mut [u32::MAX; 2])?;
+    let (push, depth) = normal_axis(target, &CellSlab::of(cell, 0), side, &pos12)?;
     let pair = LocalPair::new(target, cell, &pos12);
     let sat = pair.sat()?;
     let rot = target.pose.rotation;

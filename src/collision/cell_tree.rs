@@ -127,10 +127,10 @@ impl<'a> TargetView<'a> {
 
     /// `[min, max]` of `dir . x` over the target, for a direction in the surface's frame.
     #[inline]
-    fn project(&self, dir: Vector, hint: &mut [u32; 2]) -> [Real; 2] {
+    fn project(&self, dir: Vector) -> [Real; 2] {
         let d = self.rotation * dir;
         let shift = d.dot(self.object_in_target.translation);
-        self.target.shape.project_hinted(d, hint).map(|x| x - shift)
+        self.target.shape.project(d).map(|x| x - shift)
     }
 }
 
@@ -300,7 +300,7 @@ impl CellTree {
     /// hence `depth <= top - min(m . x) + spread * (radius + |o - c| + target radius)`. A `front`
     /// cell is the mirror image (`max(m . x) - bottom`); a `both` cell takes the larger.
     #[inline]
-    pub(crate) fn bound(&self, node: u32, view: &TargetView, hint: &mut [u32; 2]) -> Option<Real> {
+    pub(crate) fn bound(&self, node: u32, view: &TargetView) -> Option<Real> {
         let n = &self.nodes[node as usize];
         let a = &view.aabb;
         if n.lo.x > a.maxs.x || n.lo.y > a.maxs.y || n.lo.z > a.maxs.z || n.hi.x < a.mins.x || n.hi.y < a.mins.y || n.hi.z < a.mins.z {
@@ -315,7 +315,7 @@ impl CellTree {
         if t_lo.x > b.maxs.x || t_lo.y > b.maxs.y || t_lo.z > b.maxs.z || t_hi.x < b.mins.x || t_hi.y < b.mins.y || t_hi.z < b.mins.z {
             return None;
         }
-        let [a_min, a_max] = view.project(n.axis, hint);
+        let [a_min, a_max] = view.project(n.axis);
         if a_max < n.bottom - SLAB_SLACK || a_min > n.top + SLAB_SLACK || !(a_min.is_finite() && a_max.is_finite()) {
             return None;
         }

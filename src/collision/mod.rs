@@ -44,5 +44,8 @@ thread_local! {
 }
 
 #[allow(missing_docs)]
-pub fn bench_support(t: &Target, d: crate::math::Vector) -> crate::math::Real { t.shape.support_hinted(d, &mut u32::MAX.clone()) }
+pub fn bench_support(t: &Target, d: crate::math::Vector) -> crate::math::Real { t.shape.support(d) }
 impl Target { #[allow(missing_docs)] pub fn shape_points(&self) -> &[crate::math::Vector] { match &self.shape { TargetShape::Polytope(h) => h.points(), _ => &[] } } }
+
+#[allow(missing_docs)]
+pub fn exact_fraction(t: &Target) -> f64 { match &t.shape { TargetShape::Polytope(h) => h.exact_fraction(), _ => 0.0 } }

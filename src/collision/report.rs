@@ -9,11 +9,15 @@ pub struct CollideSettings {
     pub all_contacts: bool,
     /// Only ask whether the target collides: stop at the first colliding cell, no contact point.
     pub flag_only: bool,
+    /// Fill [`Contact::overlap`] and [`Contact::axis`] (the least overlap, from the full SAT of
+    /// the reported pair). Without it they are NaN, and a deepest contact that cheaper tests
+    /// already proved colliding skips that SAT (~10 µs on a 300-face link hull).
+    pub least_overlap: bool,
 }
 
 impl Default for CollideSettings {
     fn default() -> Self {
-        CollideSettings { all_contacts: false, flag_only: false }
+        CollideSettings { all_contacts: false, flag_only: false, least_overlap: true }
     }
 }
 
@@ -30,9 +34,11 @@ pub struct Contact {
     pub normal: Vector,
     /// A point within 1e-6 m of both shapes (NaN when `flag_only`).
     pub position: Vector,
-    /// Least overlap of the pair (metres): the minimal translation.
+    /// Least overlap of the pair (metres): the minimal translation (NaN unless
+    /// [`CollideSettings::least_overlap`]).
     pub overlap: Real,
-    /// Unit direction in which the target moves by `overlap` to separate.
+    /// Unit direction in which the target moves by `overlap` to separate (NaN unless
+    /// [`CollideSettings::least_overlap`]).
     pub axis: Vector,
 }
 

@@ -161,14 +161,13 @@ impl Scene {
             let view = TargetView::new(target, &object.pose, area.side);
             let pos12 = view.object_in_target;
             let side = area.side;
-            let mut hint = [u32::MAX; 2];
             let mut separating = Vector::ZERO;
             let mut hit_object = false;
             if settings.flag_only || settings.all_contacts {
                 // Every cell that can meet the target, depth first through the tree.
                 let mut stack = vec![0u32];
                 while let Some(node) = stack.pop() {
-                    if tree.bound(node, &view, &mut hint).is_none() {
+                    if tree.bound(node, &view).is_none() {
                         continue;
                     }
                     if let Some([left, right]) = tree.children(node) {
@@ -177,7 +176,7 @@ impl Scene {
                     }
                     for slab in tree.leaf_cells(node) {
                         report.candidates += 1;
-                        let Some((push, depth)) = normal_axis(target, slab, side, &pos12, &mut hint) else { continue };
+                        let Some((push, depth)) = normal_axis(target, slab, side, &pos12) else { continue };
                         let cell = &area.cells[slab.cell as usize];
                         let pair = LocalPair::new(target, cell, &pos12);
                         let Some(sat) = pair.sat_cached(&mut separating) else { continue };
@@ -193,12 +192,13 @@ impl Scene {
                         report.contacts.push(contact);
                     }
                 }
-            } else if let Some((depth, leaf, push, sat)) = deepest_cell(tree, area, &view, &mut hint, &mut report.candidates) {
+            } else if let Some((depth, leaf, push, sat)) = deepest_cell(tree, area, &view, &mut report.candidates, settings.least_overlap) {
                 hit_object = true;
                 if deepest.as_ref().map_or(true, |d| depth > d.depth) {
                     let cell = &area.cells[leaf as usize];
                     let position = LocalPair::new(target, cell, &pos12).point(push).map_or(nan, |p| target.pose * p);
-                    deepest = Some(Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position, overlap: sat.overlap, axis: rot * sat.axis });
+                    let (overlap, axis) = sat.map_or((Real::NAN, nan), |s| (s.overlap, rot * s.axis));
+                    deepest = Some(Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position, overlap, axis });
                 }
             }
             if hit_object {
@@ -261,26 +261,26 @@ impl Ord for Pending {
 /// The deepest colliding cell of one surface: `(depth, cell index, push-out normal, SAT result)`
 /// in the target's frame. Best first: subtrees are searched in the order of their depth bounds,
 /// and the search ends when no bound beats the deepest collision found. Pairs are decided by
-/// [`quick_decide`] where it can, and the winner is confirmed by the full SAT, which also gives
-/// its least overlap.
-fn deepest_cell(tree: &CellTree, area: &ThicknessArea, view: &TargetView, hint: &mut [u32; 2], candidates: &mut usize) -> Option<(Real, u32, Vector, SatOverlap)> {
-    let (depth, leaf, push) = deepest_search(tree, area, view, hint, candidates, true)?;
-    let pair = LocalPair::new(view.target, &area.cells[leaf as usize], &view.object_in_target);
-    if let Some(sat) = pair.sat() {
+/// [`quick_decide`] where it can; with `least_overlap` the winner's full SAT gives its least
+/// overlap (and, were it to disagree with the quick test, the search is run again without it).
+fn deepest_cell(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candidates: &mut usize, least_overlap: bool) -> Option<(Real, u32, Vector, Option<SatOverlap>)> {
+    let (depth, leaf, push, sat) = deepest_search(tree, area, view, candidates, true)?;
+    if sat.is_some() || !least_overlap {
         return Some((depth, leaf, push, sat));
+    }
+    if let Some(sat) = LocalPair::new(view.target, &area.cells[leaf as usize], &view.object_in_target).sat() {
+        return Some((depth, leaf, push, Some(sat)));
     }
     // The centroid test and the SAT disagreed (rounding on a razor-thin overlap): search again
     // with the SAT alone deciding.
-    let (depth, leaf, push) = deepest_search(tree, area, view, hint, candidates, false)?;
-    let sat = LocalPair::new(view.target, &area.cells[leaf as usize], &view.object_in_target).sat()?;
-    Some((depth, leaf, push, sat))
+    deepest_search(tree, area, view, candidates, false)
 }
 
-fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, hint: &mut [u32; 2], candidates: &mut usize, quick: bool) -> Option<(Real, u32, Vector)> {
-    let mut best: Option<(Real, u32, Vector)> = None;
+fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candidates: &mut usize, quick: bool) -> Option<(Real, u32, Vector, Option<SatOverlap>)> {
+    let mut best: Option<(Real, u32, Vector, Option<SatOverlap>)> = None;
     let mut best_depth = Real::NEG_INFINITY;
     let mut heap = std::collections::BinaryHeap::with_capacity(64);
-    if let Some(b) = tree.bound(0, view, hint) {
+    if let Some(b) = tree.bound(0, view) {
         heap.push(Pending(b, 0));
     }
     let mut leaf_hits: Vec<(Real, u32, Vector)> = Vec::with_capacity(8);
@@ -295,7 +295,7 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, hint
                 if recent.separate_box(centre, half) {
                     continue;
                 }
-                if let Some(b) = tree.bound(child, view, hint) {
+                if let Some(b) = tree.bound(child, view) {
                     if b > best_depth + DEPTH_TOLERANCE {
                         heap.push(Pending(b, child));
                     }
@@ -309,7 +309,7 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, hint
             if !CellTree::slab_meets_target_box(slab, view) || recent.separate_box(slab.centre, slab.half) {
                 continue;
             }
-            if let Some((push, depth)) = normal_axis_deeper(view.target, slab, area.side, &view.rotation, view.object_in_target.translation, hint, best_depth + DEPTH_TOLERANCE) {
+            if let Some((push, depth)) = normal_axis_deeper(view.target, slab, area.side, &view.rotation, view.object_in_target.translation, best_depth + DEPTH_TOLERANCE) {
                 leaf_hits.push((depth, slab.cell, push));
             }
         }
@@ -319,21 +319,21 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, hint
             let (depth, leaf, push) = leaf_hits.swap_remove(k);
             let cell = &area.cells[leaf as usize];
             let quick_answer = if quick { quick_decide(view, cell, &mut recent) } else { None };
-            let hit = match quick_answer {
-                Some(hit) => hit,
+            let (hit, sat) = match quick_answer {
+                Some(hit) => (hit, None),
                 None => {
                     let mut separating = Vector::ZERO;
-                    let hit = LocalPair::new(view.target, cell, &view.object_in_target).sat_cached(&mut separating).is_some();
+                    let sat = LocalPair::new(view.target, cell, &view.object_in_target).sat_cached(&mut separating);
                     if separating != Vector::ZERO {
                         // The SAT's axis is in the target's frame.
                         let axis = view.object_in_target.rotation.inverse() * separating;
                         recent.remember(axis, view.extent_along(axis));
                     }
-                    hit
+                    (sat.is_some(), sat)
                 }
             };
             if hit {
-                best = Some((depth, leaf, push));
+                best = Some((depth, leaf, push, sat));
                 best_depth = depth;
                 break;
             }

@@ -58,7 +58,7 @@ pub(crate) const LANES: usize = 8;
 const CLIMB_MIN_POINTS: usize = 24;
 
 /// Bins per side of each face of the cube map of climb starts.
-const START_BINS: usize = 32;
+const START_BINS: usize = 64;
 
 /// Flags a cube-map bin whose every direction has the same extreme vertex.
 const EXACT: u32 = 1 << 31;
@@ -69,9 +69,11 @@ const EXACT: u32 = 1 << 31;
 fn start_bin(dir: Vector) -> usize {
     let a = dir.abs();
     let (k, u, v) = if a.x >= a.y && a.x >= a.z { (0, dir.y, dir.z) } else if a.y >= a.z { (1, dir.z, dir.x) } else { (2, dir.x, dir.y) };
-    let m = a[k];
     let face = 2 * k + (dir[k] < 0.0) as usize;
-    let cell = |t: Real| (((t / m + 1.0) * 0.5 * START_BINS as Real) as usize).min(START_BINS - 1);
+    let half = 0.5 * START_BINS as Real;
+    let scale = half / a[k];
+    // `t * scale` lies in [-half, half]; a NaN direction lands in bin 0 (the cast saturates).
+    let cell = |t: Real| ((t * scale + half) as usize).min(START_BINS - 1);
     (face * START_BINS + cell(u)) * START_BINS + cell(v)
 }
 
@@ -89,21 +91,30 @@ fn cube_direction(face: usize, u: Real, v: Real) -> Vector {
 /// its four corner directions, and the directions along which a vertex is extreme form a convex
 /// cone: when one vertex is the unique extreme at all four corners, it is at every direction of
 /// the bin.
-fn support_cube_map(points: &[Vector]) -> Vec<u32> {
+fn support_cube_map(points: &[Vector], first: &[u32], adjacent: &[u32]) -> Vec<u32> {
     let n = START_BINS;
     let grid = |i: usize| i as Real / n as Real * 2.0 - 1.0;
-    // The extreme vertex along `dir`, and whether it is unique (by more than rounding).
-    let extreme = |dir: Vector| {
-        let (mut best, mut second, mut at) = (Real::NEG_INFINITY, Real::NEG_INFINITY, 0);
-        for (i, p) in points.iter().enumerate() {
-            let d = dir.dot(*p);
-            if d > best {
-                (second, best, at) = (best, d, i);
-            } else if d > second {
-                second = d;
+    // The extreme vertex along `dir` by hill climbing from `start`, and whether it is unique (by
+    // more than rounding): the maximisers of a convex polytope form a face, so a tie would show
+    // at a neighbour.
+    let mut at = 0usize;
+    let mut extreme = |dir: Vector| {
+        let mut best = dir.dot(points[at]);
+        loop {
+            let mut moved = false;
+            for &nb in &adjacent[first[at] as usize..first[at + 1] as usize] {
+                let d = dir.dot(points[nb as usize]);
+                if d > best {
+                    (best, at, moved) = (d, nb as usize, true);
+                }
+            }
+            if !moved {
+                break;
             }
         }
-        (at as u32, best - second > 1e-12 * (1.0 + best.abs()))
+        let margin = 1e-12 * (1.0 + best.abs());
+        let unique = adjacent[first[at] as usize..first[at + 1] as usize].iter().all(|&nb| dir.dot(points[nb as usize]) < best - margin);
+        (at as u32, unique)
     };
     let mut starts = Vec::with_capacity(6 * n * n);
     for face in 0..6 {
@@ -206,7 +217,7 @@ impl ConvexHull {
                 edge_soa[3 + k][i] = e.n2[k];
             }
         }
-        let starts = if points.len() >= CLIMB_MIN_POINTS { support_cube_map(&points) } else { Vec::new() };
+        let starts = if points.len() >= CLIMB_MIN_POINTS { support_cube_map(&points, &adjacency_first, &adjacency) } else { Vec::new() };
         let radius = points.iter().map(|p| (*p - centroid).length()).fold(0.0, Real::max);
         Some(ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), face_soa, edge_soa, adjacency_first, adjacency, starts, parry })
     }
@@ -229,6 +240,9 @@ impl ConvexHull {
         }
         Self::from_points(&pts)
     }
+
+    #[allow(missing_docs)]
+    pub fn exact_fraction(&self) -> f64 { self.starts.iter().filter(|s| **s & EXACT != 0).count() as f64 / self.starts.len().max(1) as f64 }
 
     /// The hull's vertices.
     pub fn points(&self) -> &[Vector] {
@@ -256,22 +270,17 @@ impl ConvexHull {
 }
 
 impl ConvexHull {
-    /// `max dir . x` by hill climbing over the vertex graph: on a convex polytope a vertex no
-    /// neighbour improves on is the global maximum. Starts at the vertex extreme along the centre
-    /// of `dir`'s cube-map bin, one or two steps from the answer.
-    fn climb(&self, dir: Vector) -> Real {
-        self.climb_from(dir, u32::MAX).0
-    }
 
-    /// `max dir . x` and the vertex where it is reached: looked up in the cube map where that
-    /// answers it, else by hill climbing from vertex `start` (`u32::MAX`: the cube map's start).
-    fn climb_from(&self, dir: Vector, start: u32) -> (Real, u32) {
+    /// `max dir . x`: looked up in the cube map where one vertex is extreme over the whole bin of
+    /// `dir` (~80 % of bins on a Panda link hull), else by hill climbing over the vertex graph from
+    /// the vertex extreme at the bin's centre, a step or two away (on a convex polytope a vertex
+    /// no neighbour improves on is the global maximum).
+    fn climb(&self, dir: Vector) -> Real {
         let entry = self.starts[start_bin(dir)];
         if entry & EXACT != 0 {
-            let at = entry & !EXACT;
-            return (dir.dot(self.points[at as usize]), at);
+            return dir.dot(self.points[(entry & !EXACT) as usize]);
         }
-        let mut at = if (start as usize) < self.points.len() { start as usize } else { entry as usize };
+        let mut at = entry as usize;
         let mut best = dir.dot(self.points[at]);
         loop {
             let mut moved = false;
@@ -285,7 +294,7 @@ impl ConvexHull {
                 }
             }
             if !moved {
-                return (best, at as u32);
+                return best;
             }
         }
     }
@@ -337,32 +346,11 @@ impl TargetShape {
         }
     }
 
-    /// As [`TargetShape::project`], starting the hill climbs of a hull at the vertices of the
-    /// previous call (`hint`, `[u32::MAX; 2]` at first): the cells a query visits have similar
-    /// normals, and a warm start takes a climb from ~15 steps to ~2 on a Panda link.
+    /// `max dir . x` over the shape (in its frame).
     #[inline]
-    pub(crate) fn project_hinted(&self, dir: Vector, hint: &mut [u32; 2]) -> [Real; 2] {
+    pub(crate) fn support(&self, dir: Vector) -> Real {
         match self {
-            TargetShape::Polytope(h) if h.points.len() >= CLIMB_MIN_POINTS => {
-                let (hi, at_hi) = h.climb_from(dir, hint[0]);
-                let (lo, at_lo) = h.climb_from(-dir, hint[1]);
-                *hint = [at_hi, at_lo];
-                [-lo, hi]
-            }
-            _ => self.project(dir),
-        }
-    }
-
-    /// `max dir . x` over the shape, a hull's climb starting at `hint` (`u32::MAX`: none), which
-    /// is then set to where the maximum is.
-    #[inline]
-    pub(crate) fn support_hinted(&self, dir: Vector, hint: &mut u32) -> Real {
-        match self {
-            TargetShape::Polytope(h) if h.points.len() >= CLIMB_MIN_POINTS => {
-                let (value, at) = h.climb_from(dir, *hint);
-                *hint = at;
-                value
-            }
+            TargetShape::Polytope(h) if h.points.len() >= CLIMB_MIN_POINTS => h.climb(dir),
             _ => self.project(dir)[1],
         }
     }
