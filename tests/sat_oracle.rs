@@ -13,7 +13,7 @@
 use oorandom::Rand64;
 use parry3d_f64::query;
 use parry3d_f64::query::PointQuery;
-use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cylinder, Shape, SupportMap};
+use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cylinder, Shape};
 use std::sync::Arc;
 use thickness_collision::collision::{collide_target_cell, ConvexHull, Target, TargetShape};
 use thickness_collision::math::{Pose, Real, Rotation, Vector};

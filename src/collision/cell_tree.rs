@@ -5,14 +5,18 @@
 //! over every cell under the link's bounding box (thousands at 1M triangles), and an AABB tree can
 //! only hand them all over. Each node here also carries a cone around its cells' normals and the
 //! slab the cells occupy along the cone's axis; from those follow an upper bound on the depth any
-//! of its cells can report (see [`CellTree::bound`]), and a best-first search stops as soon as
-//! no bound beats the deepest contact found. Where a surface is flat the bound is exact, and one
-//! leaf answers for the whole plane.
+//! of its cells can report (see `CellTree::bound`), and a best-first search stops as soon as no
+//! bound beats the deepest contact found. Where a surface is flat the bound is exact, and one
+//! leaf answers for the whole plane. Boxes are also compared in the target's own frame (an
+//! oriented-box test on three axes), which drops most of what a tilted link's world box takes in.
+//!
+//! Leaves hold 16 cells: on the Panda benchmark at 1M triangles, 4 and 8 were slower (more nodes
+//! to bound) and 32 too (more cells to test).
 
 use super::target::Target;
 use crate::math::{Aabb, Pose, Real, Vector};
-use parry3d_f64::math::Matrix;
 use crate::thickness::{Side, ThicknessCell};
+use parry3d_f64::math::Matrix;
 
 /// Cells per leaf.
 const LEAF_CELLS: usize = 16;
@@ -48,8 +52,8 @@ impl CellNode {
     }
 }
 
-/// What the cheap first test of a cell (its normal axis) reads, kept beside the tree in leaf
-/// order: a leaf's cells are then one contiguous read, where the cells themselves (328 bytes
+/// What the cheap first tests of a cell (its box, its normal axis) read, kept beside the tree in
+/// leaf order: a leaf's cells are then one contiguous read, where the cells themselves (328 bytes
 /// each, in input order) would cost a cache miss each on a large surface.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CellSlab {
@@ -118,16 +122,9 @@ impl<'a> TargetView<'a> {
         }
     }
 
-    /// `[min, max]` of `dir . x` over the target (surface frame), without warm start.
-    pub fn extent_along(&self, dir: Vector) -> [Real; 2] {
-        let d = self.rotation * dir;
-        let shift = d.dot(self.object_in_target.translation);
-        self.target.shape.project(d).map(|x| x - shift)
-    }
-
     /// `[min, max]` of `dir . x` over the target, for a direction in the surface's frame.
     #[inline]
-    fn project(&self, dir: Vector) -> [Real; 2] {
+    pub fn extent_along(&self, dir: Vector) -> [Real; 2] {
         let d = self.rotation * dir;
         let shift = d.dot(self.object_in_target.translation);
         self.target.shape.project(d).map(|x| x - shift)
@@ -295,10 +292,12 @@ impl CellTree {
     /// upper bound on the depth any of its cells reports.
     ///
     /// The bound, for a `back` cell with normal `n`, whose depth is `max n . (q - x)` over `q` in
-    /// the cell and `x` in the target: with `m` the cone axis, `o` the box centre and `c` the
-    /// target's centre, `n . (q - x) = m . q - m . x + (n - m) . (q - o) + (n - m) . (o - x)`,
-    /// hence `depth <= top - min(m . x) + spread * (radius + |o - c| + target radius)`. A `front`
-    /// cell is the mirror image (`max(m . x) - bottom`); a `both` cell takes the larger.
+    /// the cell and `x` in the target: with `m` the cone axis, `n . (q - x) = m . q - m . x +
+    /// (n - m) . (q - x)`, so `depth <= top - min(m . x) + max (n - m) . (q - x)`. With `o` the box
+    /// centre and `c` the target's centre, `q - x` is `o - c` give or take the box's radius and
+    /// the target's; `n - m` has length at most `spread`, and `-spread^2 / 2` of it lies along
+    /// `m`. A `front` cell is the mirror image (`max(m . x) - bottom`); a `both` cell takes the
+    /// larger.
     #[inline]
     pub(crate) fn bound(&self, node: u32, view: &TargetView) -> Option<Real> {
         let n = &self.nodes[node as usize];
@@ -315,11 +314,16 @@ impl CellTree {
         if t_lo.x > b.maxs.x || t_lo.y > b.maxs.y || t_lo.z > b.maxs.z || t_hi.x < b.mins.x || t_hi.y < b.mins.y || t_hi.z < b.mins.z {
             return None;
         }
-        let [a_min, a_max] = view.project(n.axis);
+        let [a_min, a_max] = view.extent_along(n.axis);
         if a_max < n.bottom - SLAB_SLACK || a_min > n.top + SLAB_SLACK || !(a_min.is_finite() && a_max.is_finite()) {
             return None;
         }
-        let slack = n.spread * (n.radius + (n.centre() - view.centre).length() + view.radius);
+        // `(n - m) . v` for `|n - m| <= s`: `n - m` is `-s^2/2` along `m` and at most `s` across it.
+        let d = n.centre() - view.centre;
+        let along = d.dot(n.axis);
+        let across = (d - n.axis * along).length();
+        let reach = n.radius + view.radius;
+        let slack = n.spread * (across + reach) + 0.5 * n.spread * n.spread * (along.abs() + reach);
         let depth = match view.side {
             Side::Back => n.top - a_min,
             Side::Front => a_max - n.bottom,

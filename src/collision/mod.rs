@@ -30,22 +30,3 @@ pub use self::report::{CollideSettings, Contact, TargetReport};
 pub use self::scene::{ObjectBody, Scene, SceneObject};
 pub use self::target::{ConvexHull, Target, TargetShape};
 
-#[allow(missing_docs)]
-pub struct Section(pub usize, pub std::time::Instant);
-impl Drop for Section {
-    fn drop(&mut self) {
-        let e = self.1.elapsed().as_nanos() as u64;
-        SECTIONS.with(|s| { let mut v = s.get(); v[self.0] += e; v[4 + self.0] += 1; s.set(v) });
-    }
-}
-thread_local! {
-    #[allow(missing_docs)]
-    pub static SECTIONS: std::cell::Cell<[u64; 8]> = const { std::cell::Cell::new([0; 8]) };
-}
-
-#[allow(missing_docs)]
-pub fn bench_support(t: &Target, d: crate::math::Vector) -> crate::math::Real { t.shape.support(d) }
-impl Target { #[allow(missing_docs)] pub fn shape_points(&self) -> &[crate::math::Vector] { match &self.shape { TargetShape::Polytope(h) => h.points(), _ => &[] } } }
-
-#[allow(missing_docs)]
-pub fn exact_fraction(t: &Target) -> f64 { match &t.shape { TargetShape::Polytope(h) => h.exact_fraction(), _ => 0.0 } }

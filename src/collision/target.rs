@@ -241,9 +241,6 @@ impl ConvexHull {
         Self::from_points(&pts)
     }
 
-    #[allow(missing_docs)]
-    pub fn exact_fraction(&self) -> f64 { self.starts.iter().filter(|s| **s & EXACT != 0).count() as f64 / self.starts.len().max(1) as f64 }
-
     /// The hull's vertices.
     pub fn points(&self) -> &[Vector] {
         &self.points
