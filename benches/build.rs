@@ -1,5 +1,5 @@
 //! Build benchmark: the thickness cells of a 1,000,000-triangle wavy wall, stage by stage, and the
-//! whole build up to a queryable BVH.
+//! whole build up to a queryable cell tree.
 //!
 //! `cargo bench --bench build` (about 2 minutes). The wall is `benches/query.rs`'s: 708 x 708
 //! quads, 1,002,528 triangles over 7 x 7 m, amplitude 5 cm, wavelength 50 cm, t = 2 cm, `back`.
@@ -7,16 +7,17 @@
 //! - `weld`: `mesh::weld` (hash-grid vertex welding, degenerate and duplicate triangles);
 //! - `topology`: `MeshTopology::from_welded` (edge adjacency, orientation, normals);
 //! - `cells`: `ThicknessArea::build` given the `MeshTopology`;
-//! - `bvh`: the cells' bounding boxes and parry's `Bvh::from_leaves` (binned SAH), given the cells;
+//! - `tree`: `collision::CellTree::build` (boxes, normal cones, median splits; cells put in leaf
+//!   order), given the cells;
 //! - `whole`: all of the above from the indexed triangle soup, as `Scene::add_surface` does it.
 //!
 //! `benches/run_build_comparison.sh` runs this beside coal's `BVHModelOBBRSS` build of the same
 //! triangles (`benches/coal_build.py`) and prints the ratio.
 
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion, SamplingMode, Throughput};
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use std::time::{Duration, Instant};
-use thickness_collision::math::{Aabb, Vector};
+use thickness_collision::collision::CellTree;
+use thickness_collision::math::Vector;
 use thickness_collision::mesh::{generate, weld, MeshTopology, TopologySettings};
 use thickness_collision::thickness::{ThicknessArea, ThicknessCell, ThicknessSettings};
 
@@ -40,24 +41,12 @@ fn checksum(v: &[Vector], t: &[[u32; 3]]) -> (u64, u64) {
     (cv, ct)
 }
 
-/// The bounding box of a cell (as `collision::Scene` computes it).
-fn cell_aabb(cell: &ThicknessCell) -> Aabb {
-    let v = cell.vertices();
-    let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-    Aabb::new(lo, hi)
-}
-
-fn cells_bvh(area: &ThicknessArea) -> Bvh {
-    let aabbs: Vec<Aabb> = area.cells.iter().map(cell_aabb).collect();
-    Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs)
-}
-
-fn whole(v: &[Vector], t: &[[u32; 3]], topo: &TopologySettings, cells: &ThicknessSettings) -> (ThicknessArea, Bvh) {
+fn whole(v: &[Vector], t: &[[u32; 3]], topo: &TopologySettings, cells: &ThicknessSettings) -> (ThicknessArea, CellTree) {
     let welded = weld(v, t, topo).expect("weld");
     let mesh = MeshTopology::from_welded(welded);
-    let area = ThicknessArea::build(&mesh, cells).expect("cells");
-    let bvh = cells_bvh(&area);
-    (area, bvh)
+    let mut area = ThicknessArea::build(&mesh, cells).expect("cells");
+    let tree = CellTree::build(&mut area.cells);
+    (area, tree)
 }
 
 fn bench_build(c: &mut Criterion) {
@@ -79,9 +68,11 @@ fn bench_build(c: &mut Criterion) {
     let area = ThicknessArea::build(&mesh, &settings).expect("cells");
     let t_cells = s.elapsed();
     let s = Instant::now();
-    let bvh = cells_bvh(&area);
-    let t_bvh = s.elapsed();
-    eprintln!("first pass: weld {t_weld:.2?}, topology {t_topo:.2?}, cells {t_cells:.2?}, bvh {t_bvh:.2?}");
+    let mut sorted = area.cells.clone();
+    let tree = CellTree::build(&mut sorted);
+    let t_tree = s.elapsed();
+    drop(sorted);
+    eprintln!("first pass: weld {t_weld:.2?}, topology {t_topo:.2?}, cells {t_cells:.2?}, tree {t_tree:.2?}");
     let r = &area.report;
     eprintln!(
         "cells: {} (tetrahedra {}, ratioed {}, prisms {}, diverging {}, skipped {}); boundary edges {}",
@@ -91,9 +82,9 @@ fn bench_build(c: &mut Criterion) {
     let n = area.cells.len() as f64;
     let cell_bytes = std::mem::size_of::<ThicknessCell>();
     let cells_heap = area.cells.capacity() * cell_bytes;
-    let bvh_bytes = bvh.total_memory_size();
+    let bvh_bytes = tree.memory();
     eprintln!(
-        "memory per cell: ThicknessCell {} B (Vec: {:.1} B/cell) + BVH {:.1} B/cell ({:.1} MiB in all) = {:.1} B/cell",
+        "memory per cell: ThicknessCell {} B (Vec: {:.1} B/cell) + tree {:.1} B/cell ({:.1} MiB in all) = {:.1} B/cell",
         cell_bytes,
         cells_heap as f64 / n,
         bvh_bytes as f64 / n,
@@ -108,7 +99,7 @@ fn bench_build(c: &mut Criterion) {
         bvh_bytes,
         (cells_heap + bvh_bytes) as f64 / n
     );
-    drop(bvh);
+    drop(tree);
 
     let mut g = c.benchmark_group("build_1M_wall");
     g.sample_size(10)
@@ -129,7 +120,7 @@ fn bench_build(c: &mut Criterion) {
         b.iter_batched(|| (), |()| ThicknessArea::build(black_box(&mesh), &settings).expect("cells"), BatchSize::PerIteration)
     });
     g.measurement_time(Duration::from_secs(7));
-    g.bench_function("bvh", |b| b.iter_batched(|| (), |()| cells_bvh(black_box(&area)), BatchSize::PerIteration));
+    g.bench_function("tree", |b| b.iter_batched(|| area.cells.clone(), |mut cells| CellTree::build(black_box(&mut cells)), BatchSize::PerIteration));
     g.measurement_time(Duration::from_secs(20));
     g.bench_function("whole", |b| {
         b.iter_batched(|| (), |()| whole(black_box(&v), black_box(&t), &topo, &settings), BatchSize::PerIteration)

@@ -40,9 +40,9 @@ def median(stage):
     with open(os.path.join(crit, stage, "new", "estimates.json")) as f:
         return json.load(f)["median"]["point_estimate"] * 1e-9
 
-rows = [(f"this crate: {s}", median(s)) for s in ("weld", "topology", "cells", "bvh")]
+rows = [(f"this crate: {s}", median(s)) for s in ("weld", "topology", "cells", "tree")]
 ours = median("whole")
-rows.append(("this crate: whole build (weld+topology+cells+BVH)", ours))
+rows.append(("this crate: whole build (weld+topology+cells+tree)", ours))
 rows.append((f"coal {coal['coal_version']} BVHModelOBBRSS (begin/add/endModel)", coal["coal_median_s"]))
 if "fcl_median_s" in coal:
     rows.append((f"python-fcl {coal['fcl_version']} BVHModel OBBRSS", coal["fcl_median_s"]))
@@ -57,6 +57,6 @@ print()
 print(f"ratio, this crate's whole build / coal's BVHModel build: {ours / coal['coal_median_s']:.2f}")
 if "fcl_median_s" in coal:
     print(f"ratio, this crate's whole build / python-fcl's BVHModel build: {ours / coal['fcl_median_s']:.2f}")
-print(f"memory: {float(mem['bytes_per_cell']):.0f} B per cell (ThicknessCell {mem['cell_bytes']} B + BVH "
+print(f"memory: {float(mem['bytes_per_cell']):.0f} B per cell (ThicknessCell {mem['cell_bytes']} B + tree "
       f"{int(mem['bvh_bytes']) / int(mem['cells']):.0f} B); coal memUsage {coal['coal_bytes_per_triangle']:.0f} B per triangle")
 PY
