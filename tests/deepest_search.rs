@@ -8,7 +8,8 @@
 //! - the deepest contact's depth equal to the brute-force maximum (within the 1e-9 m search
 //!   tolerance), on a cell that brute force says collides, with the depth brute force gives it;
 //! - `all_contacts` giving exactly the brute-force set of colliding cells;
-//! - `flag_only` giving the same verdict, on a cell that collides.
+//! - `flag_only` giving the same verdict, on a cell that collides, with or without the least
+//!   overlap (without it, a cell can be accepted by the centroid test alone).
 
 use oorandom::Rand64;
 use std::sync::Arc;
@@ -122,10 +123,13 @@ fn pruned_queries_agree_with_brute_force() {
                 want.sort_unstable();
                 assert_eq!(got, want, "all contacts: {context}");
 
-                let flag = scene.collide(&target, &CollideSettings { flag_only: true, ..Default::default() });
-                assert_eq!(flag.in_collision(), !truth.is_empty(), "flag only: {context}");
-                if let Some(c) = flag.contacts.first() {
-                    assert!(truth.iter().any(|(tri, _)| *tri == c.triangle), "flag only names a colliding cell: {context}");
+                for least_overlap in [true, false] {
+                    let flag = scene.collide(&target, &CollideSettings { flag_only: true, least_overlap, ..Default::default() });
+                    assert_eq!(flag.in_collision(), !truth.is_empty(), "flag only: {context}");
+                    if let Some(c) = flag.contacts.first() {
+                        assert!(truth.iter().any(|(tri, _)| *tri == c.triangle), "flag only names a colliding cell: {context}");
+                        assert_eq!(c.overlap > 0.0, least_overlap, "flag only: the overlap is there when asked for: {context}");
+                    }
                 }
             }
         }

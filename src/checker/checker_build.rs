@@ -287,7 +287,7 @@ impl Checker {
     /// its contact carries only link and object names (NaN depth, point and normal). The
     /// like-for-like counterpart of a boolean `collide` in FCL or coal.
     pub fn check_joints_flags(&self, names: &[String], positions: &[f64], memory: &mut JointMemory) -> Result<StateReport, StateError> {
-        self.check_joints_with(names, positions, memory, false, &CollideSettings { flag_only: true, ..Default::default() }).map(|(r, _)| r)
+        self.check_joints_with(names, positions, memory, false, &CollideSettings { flag_only: true, least_overlap: false, ..Default::default() }).map(|(r, _)| r)
     }
 
     fn check_joints_with(&self, names: &[String], positions: &[f64], memory: &mut JointMemory, strict: bool, settings: &CollideSettings) -> Result<(StateReport, Vec<String>), StateError> {

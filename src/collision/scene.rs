@@ -4,7 +4,7 @@ use super::cell_contact::{normal_axis, normal_axis_deeper, quick_decide, LocalPa
 use super::report::{CollideSettings, Contact, TargetReport};
 use super::target::{Target, TargetShape};
 use crate::math::{Aabb, Pose, Real, Vector};
-use crate::thickness::ThicknessArea;
+use crate::thickness::{ThicknessArea, ThicknessCell};
 use parry3d_f64::bounding_volume::BoundingVolume;
 use super::cell_tree::{CellTree, TargetView};
 use super::sat::SatOverlap;
@@ -161,7 +161,7 @@ impl Scene {
             let view = TargetView::new(target, &object.pose, area.side);
             let pos12 = view.object_in_target;
             let side = area.side;
-            let mut separating = Vector::ZERO;
+            let mut recent = RecentAxes::default();
             let mut hit_object = false;
             if settings.flag_only || settings.all_contacts {
                 // Every cell that can meet the target, depth first through the tree.
@@ -176,19 +176,25 @@ impl Scene {
                     }
                     for slab in tree.leaf_cells(node) {
                         report.candidates += 1;
+                        if !CellTree::slab_meets_target_box(slab, &view) || recent.separate_box(slab.centre, slab.half) {
+                            continue;
+                        }
                         let Some((push, depth)) = normal_axis(target, slab, side, &pos12) else { continue };
                         let cell = &area.cells[slab.cell as usize];
-                        let pair = LocalPair::new(target, cell, &pos12);
-                        let Some(sat) = pair.sat_cached(&mut separating) else { continue };
+                        let (hit, sat) = decide(&view, cell, &mut recent, settings.all_contacts || settings.least_overlap);
+                        if !hit {
+                            continue;
+                        }
                         hit_object = true;
-                        let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: nan, overlap: sat.overlap, axis: rot * sat.axis };
+                        let (overlap, axis) = sat.map_or((Real::NAN, nan), |s| (s.overlap, rot * s.axis));
+                        let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: nan, overlap, axis };
                         if settings.flag_only {
                             // A yes/no question: the first cell that collides answers it.
                             report.objects.push(oi);
                             report.contacts.push(contact);
                             return report;
                         }
-                        contact.position = pair.point(push).map_or(nan, |p| target.pose * p);
+                        contact.position = LocalPair::new(target, cell, &pos12).point(push).map_or(nan, |p| target.pose * p);
                         report.contacts.push(contact);
                     }
                 }
@@ -318,20 +324,7 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
         while let Some(k) = (0..leaf_hits.len()).max_by(|&a, &b| leaf_hits[a].0.total_cmp(&leaf_hits[b].0)) {
             let (depth, leaf, push) = leaf_hits.swap_remove(k);
             let cell = &area.cells[leaf as usize];
-            let quick_answer = if quick { quick_decide(view, cell, &mut recent) } else { None };
-            let (hit, sat) = match quick_answer {
-                Some(hit) => (hit, None),
-                None => {
-                    let mut separating = Vector::ZERO;
-                    let sat = LocalPair::new(view.target, cell, &view.object_in_target).sat_cached(&mut separating);
-                    if separating != Vector::ZERO {
-                        // The SAT's axis is in the target's frame.
-                        let axis = view.object_in_target.rotation.inverse() * separating;
-                        recent.remember(axis, view.extent_along(axis));
-                    }
-                    (sat.is_some(), sat)
-                }
-            };
+            let (hit, sat) = decide(view, cell, &mut recent, !quick);
             if hit {
                 best = Some((depth, leaf, push, sat));
                 best_depth = depth;
@@ -340,4 +333,24 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
         }
     }
     best
+}
+
+/// Whether a target and a cell whose normal axis does not separate them collide. Quick tests
+/// first ([`quick_decide`]); the SAT when they cannot tell, or to confirm a quick "yes" when
+/// `need_sat` (its least overlap is wanted). The SAT's separating axis is remembered in `recent`.
+/// Returns the verdict and the SAT's result when it ran.
+fn decide(view: &TargetView, cell: &ThicknessCell, recent: &mut RecentAxes, need_sat: bool) -> (bool, Option<SatOverlap>) {
+    match quick_decide(view, cell, recent) {
+        Some(false) => return (false, None),
+        Some(true) if !need_sat => return (true, None),
+        _ => {}
+    }
+    let mut separating = Vector::ZERO;
+    let sat = LocalPair::new(view.target, cell, &view.object_in_target).sat_cached(&mut separating);
+    if separating != Vector::ZERO {
+        // The SAT's axis is in the target's frame.
+        let axis = view.object_in_target.rotation.inverse() * separating;
+        recent.remember(axis, view.extent_along(axis));
+    }
+    (sat.is_some(), sat)
 }
