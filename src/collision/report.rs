@@ -10,8 +10,8 @@ pub struct CollideSettings {
     /// Only ask whether the target collides: stop at the first colliding cell, no contact point.
     pub flag_only: bool,
     /// Fill [`Contact::overlap`] and [`Contact::axis`] (the least overlap, from the full SAT of
-    /// the reported pair). Without it they are NaN, and a deepest contact that cheaper tests
-    /// already proved colliding skips that SAT (~10 µs on a 300-face link hull).
+    /// the reported pair). Without it a pair that cheaper tests already proved colliding skips
+    /// that SAT (~10 µs on a 300-face link hull), and they are NaN.
     pub least_overlap: bool,
 }
 
@@ -34,11 +34,10 @@ pub struct Contact {
     pub normal: Vector,
     /// A point within 1e-6 m of both shapes (NaN when `flag_only`).
     pub position: Vector,
-    /// Least overlap of the pair (metres): the minimal translation (NaN unless
-    /// [`CollideSettings::least_overlap`]).
+    /// Least overlap of the pair (metres): the minimal translation. Without
+    /// [`CollideSettings::least_overlap`] it is NaN where cheaper tests decided the pair.
     pub overlap: Real,
-    /// Unit direction in which the target moves by `overlap` to separate (NaN unless
-    /// [`CollideSettings::least_overlap`]).
+    /// Unit direction in which the target moves by `overlap` to separate (NaN with `overlap`).
     pub axis: Vector,
 }
 
