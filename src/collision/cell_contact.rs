@@ -225,7 +225,7 @@ const INSIDE_MARGIN: Real = 1e-9;
 /// ```
 pub fn collide_target_cell(target: &Target, cell: &ThicknessCell, side: Side, object_pose: &Pose, want_point: bool) -> Option<CellHit> {
     let pos12 = target.pose.inv_mul(object_pose);
-    let (push, depth) = normal_axis(target, &CellSlab::of(cell, 0), side, &pos12)?;
+    let (push, depth) = normal_axis(target, &CellSlab::of(cell), side, &pos12)?;
     let pair = LocalPair::new(target, cell, &pos12);
     let sat = pair.sat()?;
     let rot = target.pose.rotation;

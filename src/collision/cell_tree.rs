@@ -63,17 +63,15 @@ pub(crate) struct CellSlab {
     pub range: [Real; 2],
     /// `normal . x` on the face.
     pub plane_offset: Real,
-    /// Index of the cell in its area.
-    pub cell: u32,
     /// The centre and half extents of the cell's bounding box.
     pub centre: Vector,
     pub half: Vector,
 }
 
 impl CellSlab {
-    pub fn of(cell: &ThicknessCell, index: u32) -> CellSlab {
+    pub fn of(cell: &ThicknessCell) -> CellSlab {
         let (lo, hi) = cell_box(cell);
-        CellSlab { normal: cell.normal, range: cell.normal_range(), plane_offset: cell.plane_offset, cell: index, centre: (lo + hi) * 0.5, half: (hi - lo) * 0.5 }
+        CellSlab { normal: cell.normal, range: cell.normal_range(), plane_offset: cell.plane_offset, centre: (lo + hi) * 0.5, half: (hi - lo) * 0.5 }
     }
 }
 
@@ -240,7 +238,9 @@ impl CellTree {
         let (nodes, order) = (b.nodes, b.order);
         let sorted: Vec<ThicknessCell> = order.iter().map(|(_, i)| cells[*i as usize].clone()).collect();
         *cells = sorted;
-        let slabs = cells.iter().enumerate().map(|(k, c)| CellSlab::of(c, k as u32)).collect();
+        let slabs = cells.iter().map(CellSlab::of).collect();
+        let mut nodes = nodes;
+        nodes.shrink_to_fit();
         CellTree { nodes, slabs }
     }
 
@@ -258,11 +258,12 @@ impl CellTree {
         self.nodes.is_empty()
     }
 
-    /// The cells of a leaf (empty for an inner node).
+    /// The cells of a leaf (none for an inner node), with their indices in the area (the cells
+    /// are in leaf order).
     #[inline]
-    pub(crate) fn leaf_cells(&self, node: u32) -> &[CellSlab] {
+    pub(crate) fn leaf_cells(&self, node: u32) -> impl Iterator<Item = (u32, &CellSlab)> {
         let n = &self.nodes[node as usize];
-        &self.slabs[n.first as usize..(n.first + n.count) as usize]
+        (n.first..n.first + n.count).zip(&self.slabs[n.first as usize..(n.first + n.count) as usize])
     }
 
     /// The centre and half extents of a node's box.

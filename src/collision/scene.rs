@@ -174,13 +174,13 @@ impl Scene {
                         stack.extend([right, left]);
                         continue;
                     }
-                    for slab in tree.leaf_cells(node) {
+                    for (index, slab) in tree.leaf_cells(node) {
                         report.candidates += 1;
                         if !CellTree::slab_meets_target_box(slab, &view) || recent.separate_box(slab.centre, slab.half) {
                             continue;
                         }
                         let Some((push, depth)) = normal_axis(target, slab, side, &pos12) else { continue };
-                        let cell = &area.cells[slab.cell as usize];
+                        let cell = &area.cells[index as usize];
                         let (hit, sat) = decide(&view, cell, &mut recent, settings.all_contacts || settings.least_overlap);
                         if !hit {
                             continue;
@@ -310,13 +310,13 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
             continue;
         }
         leaf_hits.clear();
-        for slab in tree.leaf_cells(node) {
+        for (index, slab) in tree.leaf_cells(node) {
             *candidates += 1;
             if !CellTree::slab_meets_target_box(slab, view) || recent.separate_box(slab.centre, slab.half) {
                 continue;
             }
             if let Some((push, depth)) = normal_axis_deeper(view.target, slab, area.side, &view.rotation, view.object_in_target.translation, best_depth + DEPTH_TOLERANCE) {
-                leaf_hits.push((depth, slab.cell, push));
+                leaf_hits.push((depth, index, push));
             }
         }
         // Deepest first: the first that collides is the leaf's deepest contact. Picked one by
