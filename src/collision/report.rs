@@ -48,7 +48,8 @@ pub struct TargetReport {
     pub objects: Vec<usize>,
     /// The contacts: every colliding cell with `all_contacts`, else the deepest one only.
     pub contacts: Vec<Contact>,
-    /// Cells the broad phase handed to the SAT.
+    /// Cells in the tree leaves the query reached (each then faces its box and normal-axis tests,
+    /// and the SAT if those do not decide it).
     pub candidates: usize,
 }
 
