@@ -66,13 +66,44 @@ pub(crate) struct CellSlab {
     /// The centre and half extents of the cell's bounding box.
     pub centre: Vector,
     pub half: Vector,
+    /// `|normal - axis|` for the cone axis of the cell's leaf (0 outside a tree).
+    pub tilt: Real,
 }
 
 impl CellSlab {
     pub fn of(cell: &ThicknessCell) -> CellSlab {
         let (lo, hi) = cell_box(cell);
-        CellSlab { normal: cell.normal, range: cell.normal_range(), plane_offset: cell.plane_offset, centre: (lo + hi) * 0.5, half: (hi - lo) * 0.5 }
+        CellSlab { normal: cell.normal, range: cell.normal_range(), plane_offset: cell.plane_offset, centre: (lo + hi) * 0.5, half: (hi - lo) * 0.5, tilt: 0.0 }
     }
+
+    /// An upper bound on the depth this cell reports against the target of `leaf`, from the
+    /// leaf's projection of the target on its cone axis (see [`LeafView`]): with `n` the cell's
+    /// normal, `m` the axis and `c` the target's centre, `n . x = m . x + (n - m) . c + (n - m) .
+    /// (x - c)`, so `min n . x >= min m . x + (n - m) . c - tilt * radius`. A cell whose bound
+    /// cannot beat the deepest contact found needs no support query of its own.
+    #[inline]
+    pub fn depth_bound(&self, leaf: &LeafView) -> Real {
+        let shift = self.normal.dot(leaf.centre) - leaf.axis_centre;
+        let slack = self.tilt * leaf.radius;
+        let back = self.range[1] - leaf.extent[0] + slack - shift;
+        let front = leaf.extent[1] + slack + shift - self.range[0];
+        match leaf.side {
+            Side::Back => back,
+            Side::Front => front,
+            Side::Both => back.max(front),
+        }
+    }
+}
+
+/// A target seen from one leaf: what [`CellSlab::depth_bound`] needs (surface frame).
+pub(crate) struct LeafView {
+    /// `[min, max]` of `axis . x` over the target.
+    extent: [Real; 2],
+    /// The target's centre, and `axis . centre`.
+    centre: Vector,
+    axis_centre: Real,
+    radius: Real,
+    side: Side,
 }
 
 /// The tree over one surface's cells, in the surface's frame.
@@ -238,9 +269,14 @@ impl CellTree {
         let (nodes, order) = (b.nodes, b.order);
         let sorted: Vec<ThicknessCell> = order.iter().map(|(_, i)| cells[*i as usize].clone()).collect();
         *cells = sorted;
-        let slabs = cells.iter().map(CellSlab::of).collect();
+        let mut slabs: Vec<CellSlab> = cells.iter().map(CellSlab::of).collect();
         let mut nodes = nodes;
         nodes.shrink_to_fit();
+        for n in nodes.iter().filter(|n| n.count > 0) {
+            for slab in &mut slabs[n.first as usize..(n.first + n.count) as usize] {
+                slab.tilt = (slab.normal - n.axis).length();
+            }
+        }
         CellTree { nodes, slabs }
     }
 
@@ -271,6 +307,12 @@ impl CellTree {
     pub(crate) fn node_box(&self, node: u32) -> (Vector, Vector) {
         let n = &self.nodes[node as usize];
         (n.centre(), (n.hi - n.lo) * 0.5)
+    }
+
+    /// What the cells of leaf `node` need to bound their depths against the target.
+    pub(crate) fn leaf_view(&self, node: u32, view: &TargetView) -> LeafView {
+        let axis = self.nodes[node as usize].axis;
+        LeafView { extent: view.extent_along(axis), centre: view.centre, axis_centre: axis.dot(view.centre), radius: view.radius, side: view.side }
     }
 
     /// The children of an inner node; `None` for a leaf.

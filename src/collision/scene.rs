@@ -310,8 +310,12 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
             continue;
         }
         leaf_hits.clear();
+        let leaf = tree.leaf_view(node, view);
         for (index, slab) in tree.leaf_cells(node) {
             *candidates += 1;
+            if slab.depth_bound(&leaf) <= best_depth + DEPTH_TOLERANCE {
+                continue;
+            }
             if !CellTree::slab_meets_target_box(slab, view) || recent.separate_box(slab.centre, slab.half) {
                 continue;
             }
