@@ -76,16 +76,16 @@ fn clip(faces: &mut Vec<Vec<Vector>>, n: Vector, d: Real, tol: Real) -> bool {
 }
 
 /// The points of a convex polygon in plane normal `n`, deduplicated and ordered by angle.
-fn order_on_plane(mut pts: Vec<Vector>, n: Vector, tol: Real) -> Vec<Vector> {
+fn order_on_plane(pts: Vec<Vector>, n: Vector, tol: Real) -> Vec<Vector> {
     let c = pts.iter().copied().sum::<Vector>() / pts.len() as Real;
     let u = n.any_orthonormal_vector();
     let v = n.cross(u);
-    pts.sort_by(|a, b| {
-        let (pa, pb) = (*a - c, *b - c);
-        pa.dot(v).atan2(pa.dot(u)).total_cmp(&pb.dot(v).atan2(pb.dot(u)))
-    });
-    pts.dedup_by(|a, b| a.distance(*b) <= tol);
-    pts
+    // Each angle once: in the comparator, two atan2 per comparison were most of a contact point.
+    let mut keyed: Vec<(Real, Vector)> = pts.iter().map(|p| ((*p - c).dot(v).atan2((*p - c).dot(u)), *p)).collect();
+    keyed.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut out: Vec<Vector> = keyed.into_iter().map(|(_, p)| p).collect();
+    out.dedup_by(|a, b| a.distance(*b) <= tol);
+    out
 }
 
 /// Closest point to `p` on triangle `abc` (Ericson, RTCD 5.1.5).
