@@ -44,19 +44,18 @@ impl<'a> LocalPair<'a> {
     /// The SAT; `None` when apart.
     #[inline]
     pub fn sat(&self) -> Option<SatOverlap> {
-        let mut unused = Vector::ZERO;
-        self.sat_cached(&mut unused)
+        self.sat_or_axis().ok()
     }
 
-    /// The SAT, trying first an axis that separated a neighbouring cell (`Vector::ZERO`: none),
-    /// and keeping the axis that separates this one (hulls only).
+    /// The SAT; when apart, the axis that separates the pair (target frame; hulls only), for
+    /// neighbouring cells to try first.
     #[inline]
-    pub fn sat_cached(&self, separating: &mut Vector) -> Option<SatOverlap> {
+    pub fn sat_or_axis(&self) -> Result<SatOverlap, Option<Vector>> {
         match &self.target.shape {
-            TargetShape::Polytope(h) => sat_hull_cell(h, &self.cell, separating),
-            TargetShape::Sphere { radius } => sat_sphere_cell(*radius, &self.cell),
-            TargetShape::Capsule { half_height, radius } => sat_capsule_cell(*half_height, *radius, &self.cell),
-            TargetShape::Cylinder { half_height, radius } => sat_cylinder_cell(*half_height, *radius, &self.cell),
+            TargetShape::Polytope(h) => sat_hull_cell(h, &self.cell),
+            TargetShape::Sphere { radius } => sat_sphere_cell(*radius, &self.cell).ok_or(None),
+            TargetShape::Capsule { half_height, radius } => sat_capsule_cell(*half_height, *radius, &self.cell).ok_or(None),
+            TargetShape::Cylinder { half_height, radius } => sat_cylinder_cell(*half_height, *radius, &self.cell).ok_or(None),
         }
     }
 

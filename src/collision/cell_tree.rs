@@ -151,6 +151,16 @@ impl<'a> TargetView<'a> {
         }
     }
 
+    /// Whether a box of the surface's frame (centre, half extents), seen from the target's frame,
+    /// meets the target's own bounding box (touching counts; a NaN does not).
+    #[inline]
+    pub fn meets_own_box(&self, centre: Vector, half: Vector) -> bool {
+        let c = self.rotation * centre + self.object_in_target.translation;
+        let h = self.rotation_abs * half;
+        let b = &self.local_aabb;
+        (c - h).cmple(b.maxs).all() && b.mins.cmple(c + h).all()
+    }
+
     /// `[min, max]` of `dir . x` over the target, for a direction in the surface's frame.
     #[inline]
     pub fn extent_along(&self, dir: Vector) -> [Real; 2] {
@@ -325,10 +335,7 @@ impl CellTree {
     /// Whether a cell's box, seen from the target's frame, meets the target's own box.
     #[inline]
     pub(crate) fn slab_meets_target_box(slab: &CellSlab, view: &TargetView) -> bool {
-        let c = view.rotation * slab.centre + view.object_in_target.translation;
-        let h = view.rotation_abs * slab.half;
-        let b = &view.local_aabb;
-        (c - h).cmple(b.maxs).all() && b.mins.cmple(c + h).all()
+        view.meets_own_box(slab.centre, slab.half)
     }
 
     /// `None` when no cell of `node` can meet the target (its box misses the target's box, or the
@@ -351,11 +358,7 @@ impl CellTree {
         }
         // The node's box seen from the target's frame, against the target's own box: for a
         // link tilted across a surface this drops most of what its world box takes in.
-        let centre = view.rotation * n.centre() + view.object_in_target.translation;
-        let half = view.rotation_abs * ((n.hi - n.lo) * 0.5);
-        let (t_lo, t_hi) = (centre - half, centre + half);
-        let b = &view.local_aabb;
-        if t_lo.x > b.maxs.x || t_lo.y > b.maxs.y || t_lo.z > b.maxs.z || t_hi.x < b.mins.x || t_hi.y < b.mins.y || t_hi.z < b.mins.z {
+        if !view.meets_own_box(n.centre(), (n.hi - n.lo) * 0.5) {
             return None;
         }
         let [a_min, a_max] = view.extent_along(n.axis);

@@ -1,6 +1,6 @@
 //! The environment: objects with their cells in a BVH, and the queries against them.
 
-use super::cell_contact::{normal_axis, normal_axis_deeper, quick_decide, LocalPair, RecentAxes};
+use super::cell_contact::{normal_axis_deeper, quick_decide, LocalPair, RecentAxes};
 use super::report::{CollideSettings, Contact, TargetReport};
 use super::target::{Target, TargetShape};
 use crate::math::{Aabb, Pose, Real, Vector};
@@ -179,7 +179,7 @@ impl Scene {
                         if !CellTree::slab_meets_target_box(slab, &view) || recent.separate_box(slab.centre, slab.half) {
                             continue;
                         }
-                        let Some((push, depth)) = normal_axis(target, slab, side, &pos12) else { continue };
+                        let Some((push, depth)) = normal_axis_deeper(target, slab, side, &view.rotation, pos12.translation, Real::NEG_INFINITY) else { continue };
                         let cell = &area.cells[index as usize];
                         let (hit, sat) = decide(&view, cell, &mut recent, settings.all_contacts || settings.least_overlap);
                         if !hit {
@@ -349,12 +349,15 @@ fn decide(view: &TargetView, cell: &ThicknessCell, recent: &mut RecentAxes, need
         Some(true) if !need_sat => return (true, None),
         _ => {}
     }
-    let mut separating = Vector::ZERO;
-    let sat = LocalPair::new(view.target, cell, &view.object_in_target).sat_cached(&mut separating);
-    if separating != Vector::ZERO {
-        // The SAT's axis is in the target's frame.
-        let axis = view.object_in_target.rotation.inverse() * separating;
-        recent.remember(axis, view.extent_along(axis));
+    match LocalPair::new(view.target, cell, &view.object_in_target).sat_or_axis() {
+        Ok(sat) => (true, Some(sat)),
+        Err(separating) => {
+            if let Some(axis) = separating {
+                // The SAT's axis is in the target's frame.
+                let axis = view.object_in_target.rotation.inverse() * axis;
+                recent.remember(axis, view.extent_along(axis));
+            }
+            (false, None)
+        }
     }
-    (sat.is_some(), sat)
 }

@@ -36,11 +36,6 @@ pub struct ConvexHull {
     /// `max |x - centroid|` over the vertices.
     pub(crate) radius: Real,
     pub(crate) aabb: Aabb,
-    /// The face normals, `min` and `max` again as arrays (padded to a multiple of `LANES` with
-    /// faces that never separate) and the edges' face normals likewise, for the SAT's loops over
-    /// every face and edge, which the compiler vectorises in this layout.
-    pub(crate) face_soa: [Vec<Real>; 5],
-    pub(crate) edge_soa: [Vec<Real>; 6],
     /// Vertex adjacency (CSR: the neighbours of `i` are `adjacent[first[i]..first[i + 1]]`).
     adjacency_first: Vec<u32>,
     adjacency: Vec<u32>,
@@ -50,9 +45,6 @@ pub struct ConvexHull {
     starts: Vec<u32>,
     parry: ConvexPolyhedron,
 }
-
-/// Chunk width of the SAT's vectorised loops.
-pub(crate) const LANES: usize = 8;
 
 /// Below this many vertices a linear scan beats hill climbing.
 const CLIMB_MIN_POINTS: usize = 24;
@@ -195,31 +187,9 @@ impl ConvexHull {
             adjacency.extend_from_slice(n);
             adjacency_first[i + 1] = adjacency.len() as u32;
         }
-        let pad = |n: usize| n.div_ceil(LANES) * LANES;
-        let mut face_soa: [Vec<Real>; 5] = std::array::from_fn(|_| vec![0.0; pad(faces.len())]);
-        for (i, f) in faces.iter().enumerate() {
-            for k in 0..3 {
-                face_soa[k][i] = f.normal[k];
-            }
-            face_soa[3][i] = f.min;
-            face_soa[4][i] = f.max;
-        }
-        // Padding faces: normal 0, range [-inf, inf], which overlaps everything.
-        for i in faces.len()..pad(faces.len()) {
-            face_soa[3][i] = Real::NEG_INFINITY;
-            face_soa[4][i] = Real::INFINITY;
-        }
-        // Padding edges: zero normals, which never pass the Gauss-map test (0 * 0 < 0 is false).
-        let mut edge_soa: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; pad(edges.len())]);
-        for (i, e) in edges.iter().enumerate() {
-            for k in 0..3 {
-                edge_soa[k][i] = e.n1[k];
-                edge_soa[3 + k][i] = e.n2[k];
-            }
-        }
         let starts = if points.len() >= CLIMB_MIN_POINTS { support_cube_map(&points, &adjacency_first, &adjacency) } else { Vec::new() };
         let radius = points.iter().map(|p| (*p - centroid).length()).fold(0.0, Real::max);
-        Some(ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), face_soa, edge_soa, adjacency_first, adjacency, starts, parry })
+        Some(ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), adjacency_first, adjacency, starts, parry })
     }
 
     /// The hull grown by `padding` metres: every vertex moved out along the normal of each of its
