@@ -14,32 +14,16 @@
 //! `benches/run_build_comparison.sh` runs this beside coal's `BVHModelOBBRSS` build of the same
 //! triangles (`benches/coal_build.py`) and prints the ratio.
 
+#[path = "wall_1m.rs"]
+mod wall_1m;
+
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion, SamplingMode, Throughput};
 use std::time::{Duration, Instant};
 use thickness_collision::collision::CellTree;
 use thickness_collision::math::Vector;
-use thickness_collision::mesh::{generate, weld, MeshTopology, TopologySettings};
+use thickness_collision::mesh::{weld, MeshTopology, TopologySettings};
+use wall_1m::{checksum, wall};
 use thickness_collision::thickness::{ThicknessArea, ThicknessCell, ThicknessSettings};
-
-/// The same wall as `examples/dump_wall.rs` and `benches/query.rs`.
-fn wall() -> generate::Soup {
-    generate::wavy_sheet(708, 708, 7.0, 7.0, 0.05, 0.5)
-}
-
-/// `examples/dump_wall.rs`'s checksum, to show that the peer builds from the same triangles.
-fn checksum(v: &[Vector], t: &[[u32; 3]]) -> (u64, u64) {
-    let cv = v
-        .iter()
-        .flat_map(|p| [p.x, p.y, p.z])
-        .enumerate()
-        .fold(0u64, |s, (k, x)| s.wrapping_add(x.to_bits().wrapping_mul(2 * k as u64 + 1)));
-    let ct = t
-        .iter()
-        .flatten()
-        .enumerate()
-        .fold(0u64, |s, (k, &i)| s.wrapping_add((i as u64).wrapping_mul(2 * k as u64 + 1)));
-    (cv, ct)
-}
 
 fn whole(v: &[Vector], t: &[[u32; 3]], topo: &TopologySettings, cells: &ThicknessSettings) -> (ThicknessArea, CellTree) {
     let welded = weld(v, t, topo).expect("weld");
@@ -50,7 +34,7 @@ fn whole(v: &[Vector], t: &[[u32; 3]], topo: &TopologySettings, cells: &Thicknes
 }
 
 fn bench_build(c: &mut Criterion) {
-    let (v, t) = wall();
+    let (v, t) = wall(708, 708);
     let topo = TopologySettings::default();
     let settings = ThicknessSettings { thickness: 0.02, ..Default::default() };
     let (cv, ct) = checksum(&v, &t);

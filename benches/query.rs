@@ -4,6 +4,9 @@
 //!
 //! `cargo bench --bench query`
 
+#[path = "wall_1m.rs"]
+mod wall_1m;
+
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use parry3d_f64::query;
 use parry3d_f64::shape::TriMesh;
@@ -11,11 +14,9 @@ use std::sync::Arc;
 use std::time::Duration;
 use thickness_collision::collision::{CollideSettings, ConvexHull, Scene, Target, TargetShape};
 use thickness_collision::math::{Pose, Real, Rotation, Vector};
-use thickness_collision::mesh::{generate, MeshTopology, TopologySettings};
+use thickness_collision::mesh::{MeshTopology, TopologySettings};
 use thickness_collision::thickness::{ThicknessArea, ThicknessSettings};
-
-const AMPLITUDE: Real = 0.05;
-const WAVELENGTH: Real = 0.5;
+use wall_1m::{wall, AMPLITUDE, WAVELENGTH};
 
 /// ~200 faces: 102 points on an elongated ellipsoid the size of a Panda link (8 x 8 x 16 cm).
 fn panda_sized_hull() -> ConvexHull {
@@ -37,7 +38,7 @@ fn wall_height(x: Real, y: Real) -> Real {
 
 fn bench_query(c: &mut Criterion) {
     // 708 x 708 quads = 1,002,528 triangles over 7 x 7 m (about 1 cm triangles).
-    let (v, t) = generate::wavy_sheet(708, 708, 7.0, 7.0, AMPLITUDE, WAVELENGTH);
+    let (v, t) = wall(708, 708);
     let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).expect("mesh");
     let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: 0.02, ..Default::default() }).expect("cells");
     let mut scene = Scene::new();

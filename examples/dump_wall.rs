@@ -9,23 +9,11 @@
 //! checksum printed (and recomputed by the reader) is, over the flattened arrays,
 //! `sum_k bits(coord_k) * (2k + 1)` and `sum_k index_k * (2k + 1)`, both wrapping mod 2^64.
 
-use std::io::{BufWriter, Write};
-use thickness_collision::math::Vector;
-use thickness_collision::mesh::generate;
+#[path = "../benches/wall_1m.rs"]
+mod wall_1m;
 
-fn checksum(v: &[Vector], t: &[[u32; 3]]) -> (u64, u64) {
-    let cv = v
-        .iter()
-        .flat_map(|p| [p.x, p.y, p.z])
-        .enumerate()
-        .fold(0u64, |s, (k, x)| s.wrapping_add(x.to_bits().wrapping_mul(2 * k as u64 + 1)));
-    let ct = t
-        .iter()
-        .flatten()
-        .enumerate()
-        .fold(0u64, |s, (k, &i)| s.wrapping_add((i as u64).wrapping_mul(2 * k as u64 + 1)));
-    (cv, ct)
-}
+use std::io::{BufWriter, Write};
+use wall_1m::{checksum, wall};
 
 fn main() -> std::io::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -35,7 +23,7 @@ fn main() -> std::io::Result<()> {
     };
     let nx: usize = args.get(1).map_or(708, |s| s.parse().expect("NX"));
     let ny: usize = args.get(2).map_or(nx, |s| s.parse().expect("NY"));
-    let (v, t) = generate::wavy_sheet(nx, ny, 7.0, 7.0, 0.05, 0.5);
+    let (v, t) = wall(nx, ny);
     let mut w = BufWriter::new(std::fs::File::create(out)?);
     w.write_all(b"TCWALL01")?;
     w.write_all(&(v.len() as u64).to_le_bytes())?;
