@@ -36,7 +36,10 @@
 //! triangles. Every violation is counted and printed per mesh (nothing is hidden), and the volume
 //! the near-vertex mismatch occupies is measured separately.
 
+mod shapes;
+
 use oorandom::Rand64;
+use shapes::{aabb_of, fan_fold, segment_crosses_triangle};
 use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use std::f64::consts::PI;
@@ -67,15 +70,6 @@ fn random_pose(rng: &mut Rand64) -> Pose {
     Pose::from_parts(shift, Rotation::from_axis_angle(axis, uniform(rng, 0.0, 2.0 * PI)))
 }
 
-fn aabb_of(points: &[Vector]) -> Aabb {
-    let mut lo = points[0];
-    let mut hi = points[0];
-    for p in points {
-        lo = lo.min(*p);
-        hi = hi.max(*p);
-    }
-    Aabb::new(lo, hi)
-}
 
 fn aabb_around(p: Vector, r: Real) -> Aabb {
     Aabb::new(p - Vector::splat(r), p + Vector::splat(r))
@@ -129,23 +123,6 @@ fn closest_on_triangle(p: Vector, [a, b, c]: [Vector; 3]) -> (Vector, Feature) {
     (a + ab * (vb * denom) + ac * (vc * denom), Feature::Face)
 }
 
-/// Möller–Trumbore: does the segment from `p` to `q` cross triangle `abc` (not at `p` itself)?
-fn segment_crosses_triangle(p: Vector, q: Vector, [a, b, c]: [Vector; 3]) -> bool {
-    let d = q - p;
-    let (e1, e2) = (b - a, c - a);
-    let h = d.cross(e2);
-    let det = e1.dot(h);
-    if det.abs() < 1e-300 {
-        return false;
-    }
-    let inv = 1.0 / det;
-    let s = p - a;
-    let u = inv * s.dot(h);
-    let r = s.cross(e1);
-    let v = inv * d.dot(r);
-    let w = inv * e2.dot(r);
-    u >= 0.0 && v >= 0.0 && u + v <= 1.0 && w > 1e-12 && w <= 1.0
-}
 
 /// Solves `m x = r` by Gaussian elimination with partial pivoting; also returns `|det m|`
 /// (rows are unit vectors here, so it measures how far from parallel the planes are).
@@ -222,24 +199,6 @@ fn jitter_in_plane(soup: Soup, nx: usize, ny: usize, sx: Real, sy: Real, amount:
     (v, t)
 }
 
-/// A V-fold of two triangle fans: the crease (along y, length `l`, `m` segments) and one apex on
-/// each side at distance `w`, so that every face that touches the crease has an edge on it (no
-/// face touches the crease at a single vertex). Same convention as `generate::v_fold`.
-fn fan_fold(angle: Real, ridge: bool, w: Real, l: Real, m: usize) -> Soup {
-    let half = (PI - angle) / 2.0;
-    let s = if ridge { -1.0 } else { 1.0 };
-    let at = |u: Real, y: Real| Vector::new(u * half.cos(), y, s * u.abs() * half.sin());
-    let mut v: Vec<Vector> = (0..=m).map(|j| at(0.0, l * j as Real / m as Real)).collect();
-    v.push(at(-w, l / 2.0));
-    v.push(at(w, l / 2.0));
-    let (left, right) = (m as u32 + 1, m as u32 + 2);
-    let mut t = Vec::new();
-    for j in 0..m as u32 {
-        t.push([left, j, j + 1]);
-        t.push([j, right, j + 1]);
-    }
-    (v, t)
-}
 
 fn cases() -> Vec<Case> {
     let mut rng = Rand64::new(0x5eed_0001);
@@ -503,7 +462,7 @@ impl Probe {
         let bb = aabb_of(&[p, q]);
         let hit = self.tri_bvh.intersect_aabb(&bb).any(|g| {
             let g = g as usize;
-            g < self.faces() && g != f && segment_crosses_triangle(p, q, self.mesh.corners(g))
+            g < self.faces() && g != f && segment_crosses_triangle(p, q - p, self.mesh.corners(g), 1e-12)
         });
         hit
     }

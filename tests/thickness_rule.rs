@@ -13,7 +13,10 @@
 //! - the gap and overlap volume fractions near vertices, measured and printed;
 //! - shared walls vs. naive per-triangle prisms on V-folds: the reason the method exists.
 
+mod shapes;
+
 use oorandom::Rand64;
+use shapes::{aabb_of, fan_fold, segment_crosses_triangle};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use std::f64::consts::PI;
@@ -132,10 +135,6 @@ struct Built {
     t: Real,
 }
 
-fn aabb_of(points: &[Vector]) -> Aabb {
-    let (lo, hi) = points.iter().fold((points[0], points[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-    Aabb::new(lo, hi)
-}
 
 fn build(soup: &Soup, t: Real, side: Side, walls: WallRule) -> Built {
     let mesh = MeshTopology::build(&soup.0, &soup.1, &TopologySettings::default()).unwrap();
@@ -187,22 +186,6 @@ fn dist_point_triangle(p: Vector, [a, b, c]: [Vector; 3]) -> Real {
     dist_point_segment(p, a, b).min(dist_point_segment(p, b, c)).min(dist_point_segment(p, c, a))
 }
 
-/// Möller–Trumbore: does segment `p + s d`, `s` in `(0, 1]`, cross triangle `abc`?
-fn segment_hits_triangle(p: Vector, d: Vector, [a, b, c]: [Vector; 3]) -> bool {
-    let (e1, e2) = (b - a, c - a);
-    let h = d.cross(e2);
-    let det = e1.dot(h);
-    if det.abs() < 1e-300 {
-        return false;
-    }
-    let inv = 1.0 / det;
-    let s = p - a;
-    let u = inv * s.dot(h);
-    let q = s.cross(e1);
-    let v = inv * d.dot(q);
-    let w = inv * e2.dot(q);
-    u >= 0.0 && v >= 0.0 && u + v <= 1.0 && w > 1e-9 && w <= 1.0
-}
 
 impl Built {
     /// Cells holding `x`: (with the planes pushed out by eps, strictly inside by eps).
@@ -221,7 +204,7 @@ impl Built {
     /// Whether the segment from `p` along `d` crosses any face other than `f`.
     fn other_face_on(&self, f: usize, p: Vector, d: Vector) -> bool {
         let q = aabb_of(&[p, p + d]);
-        let hit = self.tri_bvh.intersect_aabb(&q).any(|g| g as usize != f && segment_hits_triangle(p, d, self.mesh.corners(g as usize)));
+        let hit = self.tri_bvh.intersect_aabb(&q).any(|g| g as usize != f && segment_crosses_triangle(p, d, self.mesh.corners(g as usize), 1e-9));
         hit
     }
 
@@ -592,23 +575,6 @@ fn gap_and_overlap_near_vertices_are_small_and_measured() {
     }
 }
 
-/// Two triangle fans meeting along a crease of length `l` split in `m` segments, at dihedral angle
-/// `angle`: every face has the crease as an edge, so only the crease vertices are "near a vertex".
-fn fan_fold(angle: Real, ridge: bool, w: Real, l: Real, m: usize) -> Soup {
-    let half = (PI - angle) / 2.0;
-    let s = if ridge { -1.0 } else { 1.0 };
-    let at = |u: Real, y: Real| Vector::new(u * half.cos(), y, s * u.abs() * half.sin());
-    let mut v: Vec<Vector> = (0..=m).map(|j| at(0.0, l * j as Real / m as Real)).collect();
-    v.push(at(-w, l / 2.0));
-    v.push(at(w, l / 2.0));
-    let (oa, ob) = ((m + 1) as u32, (m + 2) as u32);
-    let mut t = Vec::new();
-    for j in 0..m as u32 {
-        t.push([oa, j, j + 1]);
-        t.push([j, ob, j + 1]);
-    }
-    (v, t)
-}
 
 #[test]
 fn shared_walls_close_the_gaps_and_overlaps_of_naive_prisms_on_v_folds() {
