@@ -18,6 +18,7 @@
 mod cell_contact;
 mod cell_tree;
 mod contact_point;
+mod gjk;
 mod polytope;
 mod report;
 mod sat;

@@ -7,6 +7,7 @@ use crate::math::{Aabb, Pose, Real, Vector};
 use crate::thickness::{ThicknessArea, ThicknessCell};
 use parry3d_f64::bounding_volume::BoundingVolume;
 use super::cell_tree::{CellTree, TargetView};
+use super::gjk::{self, Verdict};
 use super::sat::SatOverlap;
 
 /// What an environment object is made of.
@@ -171,6 +172,8 @@ impl Scene {
                         continue;
                     }
                     if let Some([left, right]) = tree.children(node) {
+                        tree.prefetch(left);
+                        tree.prefetch(right);
                         stack.extend([right, left]);
                         continue;
                     }
@@ -303,6 +306,7 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
                 }
                 if let Some(b) = tree.bound(child, view) {
                     if b > best_depth + DEPTH_TOLERANCE {
+                        tree.prefetch(child);
                         heap.push(Pending(b, child));
                     }
                 }
@@ -340,14 +344,27 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
 }
 
 /// Whether a target and a cell whose normal axis does not separate them collide. Quick tests
-/// first ([`quick_decide`]); the SAT when they cannot tell, or to confirm a quick "yes" when
-/// `need_sat` (its least overlap is wanted). The SAT's separating axis is remembered in `recent`.
-/// Returns the verdict and the SAT's result when it ran.
+/// first ([`quick_decide`]), then for hulls a GJK whose verdicts carry their proofs
+/// ([`gjk::hull_cell`]); the SAT when neither can tell, or to confirm a "yes" when `need_sat` (its
+/// least overlap is wanted). Separating axes found are remembered in `recent`. Returns the
+/// verdict and the SAT's result when it ran.
 fn decide(view: &TargetView, cell: &ThicknessCell, recent: &mut RecentAxes, need_sat: bool) -> (bool, Option<SatOverlap>) {
     match quick_decide(view, cell, recent) {
         Some(false) => return (false, None),
         Some(true) if !need_sat => return (true, None),
         _ => {}
+    }
+    if let (TargetShape::Polytope(hull), false) = (&view.target.shape, need_sat) {
+        match gjk::hull_cell(hull, &cell.vertices().map(|v| view.object_in_target * v)) {
+            Verdict::Overlap => return (true, None),
+            Verdict::Apart(axis) => {
+                // The axis is in the target's frame.
+                let axis = view.object_in_target.rotation.inverse() * axis.normalize();
+                recent.remember(axis, view.extent_along(axis));
+                return (false, None);
+            }
+            Verdict::Unknown => {}
+        }
     }
     match LocalPair::new(view.target, cell, &view.object_in_target).sat_or_axis() {
         Ok(sat) => (true, Some(sat)),

@@ -36,13 +36,16 @@ pub struct ConvexHull {
     /// `max |x - centroid|` over the vertices.
     pub(crate) radius: Real,
     pub(crate) aabb: Aabb,
-    /// Vertex adjacency (CSR: the neighbours of `i` are `adjacent[first[i]..first[i + 1]]`).
+    /// The vertices that share a face with each vertex (CSR: those of `i` are
+    /// `adjacent[first[i]..first[i + 1]]`).
     adjacency_first: Vec<u32>,
     adjacency: Vec<u32>,
     /// For each bin of a cube map over directions (see `start_bin`): the vertex extreme along
     /// every direction of the bin, flagged with `EXACT`, when one vertex is (then no climb is
-    /// needed); else the vertex extreme along the bin's centre, where climbing starts.
-    starts: Vec<u32>,
+    /// needed); else the vertex extreme along the bin's centre, where climbing starts. 16 bits,
+    /// for half the cache footprint of 32 (the map is read at random); a hull of `2^15` vertices
+    /// or more has no map and climbs from vertex 0.
+    starts: Vec<u16>,
     parry: ConvexPolyhedron,
 }
 
@@ -53,7 +56,7 @@ const CLIMB_MIN_POINTS: usize = 24;
 const START_BINS: usize = 64;
 
 /// Flags a cube-map bin whose every direction has the same extreme vertex.
-const EXACT: u32 = 1 << 31;
+const EXACT: u16 = 1 << 15;
 
 /// The cube-map bin of a direction: the face of its largest coordinate, then the two others
 /// divided by it, binned.
@@ -83,7 +86,7 @@ fn cube_direction(face: usize, u: Real, v: Real) -> Vector {
 /// its four corner directions, and the directions along which a vertex is extreme form a convex
 /// cone: when one vertex is the unique extreme at all four corners, it is at every direction of
 /// the bin.
-fn support_cube_map(points: &[Vector], first: &[u32], adjacent: &[u32]) -> Vec<u32> {
+fn support_cube_map(points: &[Vector], first: &[u32], adjacent: &[u32]) -> Vec<u16> {
     let n = START_BINS;
     let grid = |i: usize| i as Real / n as Real * 2.0 - 1.0;
     // The extreme vertex along `dir` by hill climbing from `start`, and whether it is unique (by
@@ -106,11 +109,11 @@ fn support_cube_map(points: &[Vector], first: &[u32], adjacent: &[u32]) -> Vec<u
         }
         let margin = 1e-12 * (1.0 + best.abs());
         let unique = adjacent[first[at] as usize..first[at + 1] as usize].iter().all(|&nb| dir.dot(points[nb as usize]) < best - margin);
-        (at as u32, unique)
+        (at as u16, unique)
     };
     let mut starts = Vec::with_capacity(6 * n * n);
     for face in 0..6 {
-        let corners: Vec<(u32, bool)> = (0..=n).flat_map(|i| (0..=n).map(move |j| (i, j))).map(|(i, j)| extreme(cube_direction(face, grid(i), grid(j)))).collect();
+        let corners: Vec<(u16, bool)> = (0..=n).flat_map(|i| (0..=n).map(move |j| (i, j))).map(|(i, j)| extreme(cube_direction(face, grid(i), grid(j)))).collect();
         for i in 0..n {
             for j in 0..n {
                 let c = [corners[i * (n + 1) + j], corners[i * (n + 1) + j + 1], corners[(i + 1) * (n + 1) + j], corners[(i + 1) * (n + 1) + j + 1]];
@@ -175,8 +178,20 @@ impl ConvexHull {
             let (pa, pb) = (points[a as usize], points[b as usize]);
             let (n1, n2) = (faces[fs[0]].normal, faces[fs[1]].normal);
             edges.push(HullEdge { point: pa, dir: (pb - pa).normalize(), n1, n2, arc: n2.cross(n1) });
-            neighbours[a as usize].push(b);
-            neighbours[b as usize].push(a);
+        }
+        // Climbing neighbours: every vertex that shares a face, not only the polygon's edges.
+        // parry merges nearly coplanar triangles into one polygon, and a vertex no polygon
+        // neighbour beats could still lose to a vertex across the polygon (by ~1e-6 m on a
+        // random point cloud's hull); the true hull's edges at a vertex all lie in its faces.
+        for f in parry.faces() {
+            let verts = &adj[f.first_vertex_or_edge as usize..(f.first_vertex_or_edge + f.num_vertices_or_edges) as usize];
+            for &a in verts {
+                for &b in verts {
+                    if a != b && !neighbours[a as usize].contains(&b) {
+                        neighbours[a as usize].push(b);
+                    }
+                }
+            }
         }
         if faces.len() < 4 || !centroid.is_finite() || edges.iter().any(|e| !e.dir.is_finite()) {
             return None;
@@ -187,7 +202,7 @@ impl ConvexHull {
             adjacency.extend_from_slice(n);
             adjacency_first[i + 1] = adjacency.len() as u32;
         }
-        let starts = if points.len() >= CLIMB_MIN_POINTS { support_cube_map(&points, &adjacency_first, &adjacency) } else { Vec::new() };
+        let starts = if points.len() >= CLIMB_MIN_POINTS && points.len() < EXACT as usize { support_cube_map(&points, &adjacency_first, &adjacency) } else { Vec::new() };
         let radius = points.iter().map(|p| (*p - centroid).length()).fold(0.0, Real::max);
         Some(ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), adjacency_first, adjacency, starts, parry })
     }
@@ -243,9 +258,17 @@ impl ConvexHull {
     /// the vertex extreme at the bin's centre, a step or two away (on a convex polytope a vertex
     /// no neighbour improves on is the global maximum).
     fn climb(&self, dir: Vector) -> Real {
-        let entry = self.starts[start_bin(dir)];
+        self.climb_vertex(dir).0
+    }
+
+    /// [`ConvexHull::climb`] and the vertex it ends at.
+    #[inline]
+    fn climb_vertex(&self, dir: Vector) -> (Real, usize) {
+        // No map on a hull of 2^15 vertices or more: climb from vertex 0.
+        let entry = self.starts.get(start_bin(dir)).copied().unwrap_or(0);
         if entry & EXACT != 0 {
-            return dir.dot(self.points[(entry & !EXACT) as usize]);
+            let at = (entry & !EXACT) as usize;
+            return (dir.dot(self.points[at]), at);
         }
         let mut at = entry as usize;
         let mut best = dir.dot(self.points[at]);
@@ -261,9 +284,26 @@ impl ConvexHull {
                 }
             }
             if !moved {
-                return best;
+                return (best, at);
             }
         }
+    }
+
+    /// A vertex extreme along `dir`.
+    #[inline]
+    pub(crate) fn support_point(&self, dir: Vector) -> Vector {
+        if self.points.len() >= CLIMB_MIN_POINTS {
+            return self.points[self.climb_vertex(dir).1];
+        }
+        let mut best = self.points[0];
+        let mut d = dir.dot(best);
+        for p in &self.points[1..] {
+            let x = dir.dot(*p);
+            if x > d {
+                (best, d) = (*p, x);
+            }
+        }
+        best
     }
 }
 
