@@ -134,17 +134,27 @@ pub(crate) struct TargetView<'a> {
 }
 
 impl<'a> TargetView<'a> {
-    pub fn new(target: &'a Target, object_pose: &Pose, side: Side) -> Self {
+    /// `world_aabb` is the target's exact box in the world.
+    pub fn new(target: &'a Target, object_pose: &Pose, side: Side, world_aabb: &Aabb) -> Self {
         let target_in_object = object_pose.inv_mul(&target.pose);
         let object_in_target = target_in_object.inverse();
         let rotation = Matrix::from_quat(object_in_target.rotation);
+        // Walls, shelves and tables usually stand square to the world: then the world box, turned
+        // into the surface's frame, is the exact box there too (to rounding), and the six support
+        // queries of an exact box are saved.
+        let square = Matrix::from_quat(object_pose.rotation).abs();
+        let aabb = if [square.row(0), square.row(1), square.row(2)].iter().all(|r| r.max_element() > 1.0 - 1e-12 && r.element_sum() < 1.0 + 1e-9) {
+            transformed_box(world_aabb, &object_pose.inverse())
+        } else {
+            target.aabb_in(&target_in_object)
+        };
         TargetView {
             target,
             object_in_target,
             local_aabb: target.shape.local_aabb(),
             rotation,
             rotation_abs: rotation.abs(),
-            aabb: target.aabb_in(&target_in_object),
+            aabb,
             centre: target_in_object * target.shape.centre(),
             radius: target.shape.bounding_radius(),
             side,
@@ -185,6 +195,15 @@ impl<'a> TargetView<'a> {
         let shift = d.dot(self.object_in_target.translation);
         self.target.shape.project(d).map(|x| x - shift)
     }
+}
+
+/// The box around a box of another frame (`pose` maps that frame into this one).
+pub(crate) fn transformed_box(local: &Aabb, pose: &Pose) -> Aabb {
+    let c = *pose * local.center();
+    let h = local.half_extents();
+    let m = Matrix::from_quat(pose.rotation).abs();
+    let e = Vector::new(m.row(0).dot(h), m.row(1).dot(h), m.row(2).dot(h));
+    Aabb::new(c - e, c + e)
 }
 
 fn cell_box(cell: &ThicknessCell) -> (Vector, Vector) {

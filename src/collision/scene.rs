@@ -6,7 +6,7 @@ use super::target::{Target, TargetShape};
 use crate::math::{Aabb, Pose, Real, Vector};
 use crate::thickness::{ThicknessArea, ThicknessCell};
 use parry3d_f64::bounding_volume::BoundingVolume;
-use super::cell_tree::{CellTree, TargetView};
+use super::cell_tree::{transformed_box, CellTree, TargetView};
 use super::gjk::{self, Verdict};
 use super::sat::SatOverlap;
 
@@ -34,15 +34,6 @@ pub struct SceneObject {
     pub body: ObjectBody,
     /// Its bounding box in the world (a first, cheap reject per target).
     world_aabb: Aabb,
-}
-
-/// The world box of a box given in a frame posed at `pose`.
-fn transformed_aabb(local: &Aabb, pose: &Pose) -> Aabb {
-    let c = *pose * local.center();
-    let h = local.half_extents();
-    let m = parry3d_f64::math::Matrix::from_quat(pose.rotation);
-    let e = Vector::new(m.row(0).abs().dot(h), m.row(1).abs().dot(h), m.row(2).abs().dot(h));
-    Aabb::new(c - e, c + e)
 }
 
 impl SceneObject {
@@ -80,14 +71,14 @@ impl Scene {
     /// The area's cells are reordered for the broad phase (see [`CellTree::build`]).
     pub fn add_surface(&mut self, name: impl Into<String>, pose: Pose, mut area: ThicknessArea) -> usize {
         let tree = CellTree::build(&mut area.cells);
-        let world_aabb = if tree.is_empty() { Aabb::new_invalid() } else { transformed_aabb(&tree.root_aabb(), &pose) };
+        let world_aabb = if tree.is_empty() { Aabb::new_invalid() } else { transformed_box(&tree.root_aabb(), &pose) };
         self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Surface { area, tree }, world_aabb });
         self.objects.len() - 1
     }
 
     /// Adds a convex solid placed at `pose` in the world. Returns the object's index.
     pub fn add_solid(&mut self, name: impl Into<String>, pose: Pose, shape: TargetShape) -> usize {
-        let world_aabb = transformed_aabb(&shape.local_aabb(), &pose);
+        let world_aabb = transformed_box(&shape.local_aabb(), &pose);
         self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Solid(shape), world_aabb });
         self.objects.len() - 1
     }
@@ -159,7 +150,7 @@ impl Scene {
             if tree.is_empty() {
                 continue;
             }
-            let view = TargetView::new(target, &object.pose, area.side);
+            let view = TargetView::new(target, &object.pose, area.side, &target_aabb);
             let pos12 = view.object_in_target;
             let side = area.side;
             let mut recent = RecentAxes::default();
