@@ -5,8 +5,8 @@
 //! over every cell under the link's bounding box (thousands at 1M triangles), and an AABB tree can
 //! only hand them all over. Each node here also carries a cone around its cells' normals and the
 //! slab the cells occupy along the cone's axis; from those follow an upper bound on the depth any
-//! of its cells can report (see `CellTree::bound`), and a best-first search stops as soon as no
-//! bound beats the deepest contact found. Where a surface is flat the bound is exact, and one
+//! of its cells can report (see `CellTree::bound`), and a search skips every subtree whose
+//! bound cannot beat the deepest contact found. Where a surface is flat the bound is exact, and one
 //! leaf answers for the whole plane. Boxes are also compared in the target's own frame (an
 //! oriented-box test on three axes), which drops most of what a tilted link's world box takes in.
 //!

@@ -233,7 +233,7 @@ mod tests {
             let cell_in_hull = pose.inverse();
             let local = CellPolytope::new(cell, &cell_in_hull);
             let sat = sat_hull_cell(hull, &local);
-            let mut check = |local: &CellPolytope, sat: &Result<_, _>, what: &str| -> Verdict {
+            let check = |local: &CellPolytope, sat: &Result<_, _>, what: &str| -> Verdict {
                 let verdict = hull_cell(hull, &local.verts);
                 match verdict {
                     Verdict::Overlap => assert!(sat.is_ok(), "pair {i} ({what}): GJK says overlap, the SAT apart"),

@@ -238,29 +238,14 @@ fn collide_solid(target: &Target, object: usize, object_pose: &Pose, shape: &Tar
 /// their depth up to rounding, are not searched again and again.
 const DEPTH_TOLERANCE: Real = 1e-9;
 
-/// A node of the best-first search, ordered by its bound.
+/// A node waiting in the search, with the bound on its cells' depths.
 struct Pending(Real, u32);
 
-impl PartialEq for Pending {
-    fn eq(&self, other: &Self) -> bool {
-        self.0.total_cmp(&other.0).is_eq()
-    }
-}
-impl Eq for Pending {}
-impl PartialOrd for Pending {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Pending {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.0.total_cmp(&other.0)
-    }
-}
-
 /// The deepest colliding cell of one surface: `(depth, cell index, push-out normal, SAT result)`
-/// in the target's frame. Best first: subtrees are searched in the order of their depth bounds,
-/// and the search ends when no bound beats the deepest collision found. Pairs are decided by
+/// in the target's frame. Depth first, the child with the deeper bound first, and a subtree is
+/// skipped when its bound cannot beat the deepest collision found. (A best-first search with a
+/// heap, which stops at the first bound that cannot, measured 2 % slower on the Panda benchmark:
+/// with these bounds it expands nearly the same nodes, and pays for the heap.) Pairs are decided by
 /// [`quick_decide`] where it can; with `least_overlap` the winner's full SAT gives its least
 /// overlap (and, were it to disagree with the quick test, the search is run again without it).
 fn deepest_cell(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candidates: &mut usize, least_overlap: bool) -> Option<(Real, u32, Vector, Option<SatOverlap>)> {
@@ -279,17 +264,19 @@ fn deepest_cell(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candid
 fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candidates: &mut usize, quick: bool) -> Option<(Real, u32, Vector, Option<SatOverlap>)> {
     let mut best: Option<(Real, u32, Vector, Option<SatOverlap>)> = None;
     let mut best_depth = Real::NEG_INFINITY;
-    let mut heap = std::collections::BinaryHeap::with_capacity(64);
+    let mut stack: Vec<Pending> = Vec::with_capacity(64);
     if let Some(b) = tree.bound(0, view) {
-        heap.push(Pending(b, 0));
+        stack.push(Pending(b, 0));
     }
     let mut leaf_hits: Vec<(Real, u32, Vector)> = Vec::with_capacity(8);
     let mut recent = RecentAxes::default();
-    while let Some(Pending(bound, node)) = heap.pop() {
+    while let Some(Pending(bound, node)) = stack.pop() {
         if bound <= best_depth + DEPTH_TOLERANCE {
-            break;
+            continue;
         }
         if let Some(children) = tree.children(node) {
+            let mut next = [Pending(Real::NEG_INFINITY, 0), Pending(Real::NEG_INFINITY, 0)];
+            let mut n = 0;
             for child in children {
                 let (centre, half) = tree.node_box(child);
                 if recent.separate_box(centre, half) {
@@ -298,10 +285,16 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
                 if let Some(b) = tree.bound(child, view) {
                     if b > best_depth + DEPTH_TOLERANCE {
                         tree.prefetch(child);
-                        heap.push(Pending(b, child));
+                        next[n] = Pending(b, child);
+                        n += 1;
                     }
                 }
             }
+            // The deeper bound on top of the stack.
+            if n == 2 && next[0].0 > next[1].0 {
+                next.swap(0, 1);
+            }
+            stack.extend(next.into_iter().take(n));
             continue;
         }
         leaf_hits.clear();
