@@ -97,32 +97,68 @@ pub(crate) fn normal_axis(target: &Target, cell: &CellSlab, side: Side, pos12: &
 /// target's frame (a matrix: rotating many normals by one quaternion costs more).
 #[inline]
 pub(crate) fn normal_axis_deeper(target: &Target, cell: &CellSlab, side: Side, rotation: &Matrix, translation: Vector, floor: Real) -> Option<(Vector, Real)> {
-    let n = *rotation * cell.normal;
-    let shift = n.dot(translation);
-    let [b_min, b_max] = cell.range.map(|x| x + shift);
-    let front = match side {
-        Side::Back => true,
-        Side::Front => false,
-        Side::Both => n.dot(target.shape.centre()) >= cell.plane_offset + shift,
-    };
-    // Apart on this axis when `a_max <= b_min` or `b_max <= a_min` (touching is apart); the
-    // negated comparisons also turn a NaN into "apart".
-    if front {
-        let a_min = -target.shape.support(-n);
-        let depth = b_max - a_min;
-        if !(depth > 0.0 && depth > floor) {
-            return None;
+    let axis = NormalAxis::new(target, cell, side, rotation, translation);
+    axis.finish(target, target.shape.support(axis.first_query()), floor)
+}
+
+/// [`normal_axis_deeper`] in two steps, so that a leaf's support queries can be made together
+/// (see [`TargetShape::support_many`](super::target::TargetShape::support_many)): the cell's
+/// normal in the target's frame, its range on it, and which end of the target gives the depth.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct NormalAxis {
+    n: Vector,
+    b_min: Real,
+    b_max: Real,
+    /// The target is pushed out along `n` (else along `-n`).
+    front: bool,
+}
+
+impl NormalAxis {
+    #[inline]
+    pub fn new(target: &Target, cell: &CellSlab, side: Side, rotation: &Matrix, translation: Vector) -> NormalAxis {
+        let n = *rotation * cell.normal;
+        let shift = n.dot(translation);
+        let [b_min, b_max] = cell.range.map(|x| x + shift);
+        let front = match side {
+            Side::Back => true,
+            Side::Front => false,
+            Side::Both => n.dot(target.shape.centre()) >= cell.plane_offset + shift,
+        };
+        NormalAxis { n, b_min, b_max, front }
+    }
+
+    /// The direction whose support gives the depth.
+    #[inline]
+    pub fn first_query(&self) -> Vector {
+        if self.front {
+            -self.n
+        } else {
+            self.n
         }
-        let a_max = target.shape.support(n);
-        (a_max > b_min).then_some((n, depth))
-    } else {
-        let a_max = target.shape.support(n);
-        let depth = a_max - b_min;
-        if !(depth > 0.0 && depth > floor) {
-            return None;
+    }
+
+    /// The verdict on this axis from the support along [`NormalAxis::first_query`]; the other
+    /// end is asked only of a pair deeper than `floor`.
+    #[inline]
+    pub fn finish(&self, target: &Target, first: Real, floor: Real) -> Option<(Vector, Real)> {
+        let (n, b_min, b_max) = (self.n, self.b_min, self.b_max);
+        // Apart on this axis when `a_max <= b_min` or `b_max <= a_min` (touching is apart); the
+        // negated comparisons also turn a NaN into "apart".
+        if self.front {
+            let depth = b_max + first;
+            if !(depth > 0.0 && depth > floor) {
+                return None;
+            }
+            let a_max = target.shape.support(n);
+            (a_max > b_min).then_some((n, depth))
+        } else {
+            let depth = first - b_min;
+            if !(depth > 0.0 && depth > floor) {
+                return None;
+            }
+            let a_min = -target.shape.support(-n);
+            (b_max > a_min).then_some((-n, depth))
         }
-        let a_min = -target.shape.support(-n);
-        (b_max > a_min).then_some((-n, depth))
     }
 }
 

@@ -188,6 +188,22 @@ impl<'a> TargetView<'a> {
         }
     }
 
+    /// [`TargetView::depth_extent_along`] given the support query it makes (`support(-d)` for
+    /// `back`, `support(d)` for `front`, with `d` the direction in the target's frame).
+    #[inline]
+    pub fn depth_extent_from(&self, dir: Vector, support: Real) -> [Real; 2] {
+        let d = self.rotation * dir;
+        let shift = d.dot(self.object_in_target.translation);
+        let b = &self.local_aabb;
+        let c = d.dot((b.mins + b.maxs) * 0.5);
+        let r = d.abs().dot((b.maxs - b.mins) * 0.5);
+        match self.side {
+            Side::Back => [-support - shift, c + r - shift],
+            Side::Front => [c - r - shift, support - shift],
+            Side::Both => self.target.shape.project(d).map(|x| x - shift),
+        }
+    }
+
     /// `[min, max]` of `dir . x` over the target, for a direction in the surface's frame.
     #[inline]
     pub fn extent_along(&self, dir: Vector) -> [Real; 2] {
@@ -416,17 +432,61 @@ impl CellTree {
     /// larger.
     #[inline]
     pub(crate) fn bound(&self, node: u32, view: &TargetView) -> Option<Real> {
+        if !self.boxes_meet(node, view) {
+            return None;
+        }
+        let extent = view.depth_extent_along(self.nodes[node as usize].axis);
+        self.bound_from(node, view, extent)
+    }
+
+    /// [`CellTree::bound`] of two nodes (those with `keep` set; `None` for the others), their
+    /// support queries made together (see `TargetShape::support_many`).
+    #[inline]
+    pub(crate) fn bounds(&self, nodes: [u32; 2], keep: [bool; 2], view: &TargetView) -> [Option<Real>; 2] {
+        let mut out = [None, None];
+        if matches!(view.side, Side::Both) {
+            for k in 0..2 {
+                if keep[k] {
+                    out[k] = self.bound(nodes[k], view);
+                }
+            }
+            return out;
+        }
+        let (mut dirs, mut which, mut count) = ([Vector::ZERO; 2], [0usize; 2], 0);
+        for k in 0..2 {
+            if keep[k] && self.boxes_meet(nodes[k], view) {
+                let d = view.rotation * self.nodes[nodes[k] as usize].axis;
+                dirs[count] = if matches!(view.side, Side::Back) { -d } else { d };
+                which[count] = k;
+                count += 1;
+            }
+        }
+        let mut supports = [0.0; 2];
+        view.target.shape.support_many(&dirs[..count], &mut supports[..count]);
+        for j in 0..count {
+            let node = nodes[which[j]];
+            out[which[j]] = self.bound_from(node, view, view.depth_extent_from(self.nodes[node as usize].axis, supports[j]));
+        }
+        out
+    }
+
+    /// Whether a node's box meets the target's, in the surface's frame and in the target's.
+    #[inline]
+    fn boxes_meet(&self, node: u32, view: &TargetView) -> bool {
         let n = &self.nodes[node as usize];
         let a = &view.aabb;
         if n.lo.x > a.maxs.x || n.lo.y > a.maxs.y || n.lo.z > a.maxs.z || n.hi.x < a.mins.x || n.hi.y < a.mins.y || n.hi.z < a.mins.z {
-            return None;
+            return false;
         }
         // The node's box seen from the target's frame, against the target's own box: for a
         // link tilted across a surface this drops most of what its world box takes in.
-        if !view.meets_own_box(n.centre(), (n.hi - n.lo) * 0.5) {
-            return None;
-        }
-        let [a_min, a_max] = view.depth_extent_along(n.axis);
+        view.meets_own_box(n.centre(), (n.hi - n.lo) * 0.5)
+    }
+
+    /// The rest of [`CellTree::bound`], given the target's extent along the node's axis.
+    #[inline]
+    fn bound_from(&self, node: u32, view: &TargetView, [a_min, a_max]: [Real; 2]) -> Option<Real> {
+        let n = &self.nodes[node as usize];
         if a_max < n.bottom - SLAB_SLACK || a_min > n.top + SLAB_SLACK || !(a_min.is_finite() && a_max.is_finite()) {
             return None;
         }

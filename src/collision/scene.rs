@@ -1,8 +1,8 @@
 //! The environment: objects with their cells in a BVH, and the queries against them.
 
-use super::cell_contact::{normal_axis_deeper, quick_decide, LocalPair, RecentAxes};
+use super::cell_contact::{normal_axis_deeper, quick_decide, LocalPair, NormalAxis, RecentAxes};
 use super::report::{CollideSettings, Contact, TargetReport};
-use super::target::{Target, TargetShape};
+use super::target::{Target, TargetShape, MANY};
 use crate::math::{Aabb, Pose, Real, Vector};
 use crate::thickness::{ThicknessArea, ThicknessCell};
 use parry3d_f64::bounding_volume::BoundingVolume;
@@ -277,12 +277,12 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
         if let Some(children) = tree.children(node) {
             let mut next = [Pending(Real::NEG_INFINITY, 0), Pending(Real::NEG_INFINITY, 0)];
             let mut n = 0;
-            for child in children {
+            let keep = children.map(|child| {
                 let (centre, half) = tree.node_box(child);
-                if recent.separate_box(centre, half) {
-                    continue;
-                }
-                if let Some(b) = tree.bound(child, view) {
+                !recent.separate_box(centre, half)
+            });
+            for (child, bound) in children.into_iter().zip(tree.bounds(children, keep, view)) {
+                if let Some(b) = bound {
                     if b > best_depth + DEPTH_TOLERANCE {
                         tree.prefetch(child);
                         next[n] = Pending(b, child);
@@ -299,6 +299,10 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
         }
         leaf_hits.clear();
         let leaf = tree.leaf_view(node, view);
+        // The cells that pass their bound and boxes, then their support queries together.
+        let mut axes = [(0u32, None::<NormalAxis>); MANY];
+        let mut dirs = [Vector::ZERO; MANY];
+        let mut count = 0;
         for (index, slab) in tree.leaf_cells(node) {
             *candidates += 1;
             if slab.depth_bound(&leaf) <= best_depth + DEPTH_TOLERANCE {
@@ -307,8 +311,23 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
             if !CellTree::slab_meets_target_box(slab, view) || recent.separate_box(slab.centre, slab.half) {
                 continue;
             }
-            if let Some((push, depth)) = normal_axis_deeper(view.target, slab, area.side, &view.rotation, view.object_in_target.translation, best_depth + DEPTH_TOLERANCE) {
-                leaf_hits.push((depth, index, push));
+            let axis = NormalAxis::new(view.target, slab, area.side, &view.rotation, view.object_in_target.translation);
+            if count == MANY {
+                // Leaves hold at most MANY cells; were one larger, its extra cells go one by one.
+                if let Some((push, depth)) = axis.finish(view.target, view.target.shape.support(axis.first_query()), best_depth + DEPTH_TOLERANCE) {
+                    leaf_hits.push((depth, index, push));
+                }
+                continue;
+            }
+            dirs[count] = axis.first_query();
+            axes[count] = (index, Some(axis));
+            count += 1;
+        }
+        let mut supports = [0.0; MANY];
+        view.target.shape.support_many(&dirs[..count], &mut supports[..count]);
+        for ((index, axis), first) in axes[..count].iter().zip(supports) {
+            if let Some((push, depth)) = axis.and_then(|a| a.finish(view.target, first, best_depth + DEPTH_TOLERANCE)) {
+                leaf_hits.push((depth, *index, push));
             }
         }
         // Deepest first: the first that collides is the leaf's deepest contact. Picked one by

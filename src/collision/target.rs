@@ -52,6 +52,9 @@ pub struct ConvexHull {
 /// Below this many vertices a linear scan beats hill climbing.
 const CLIMB_MIN_POINTS: usize = 24;
 
+/// The most directions [`TargetShape::support_many`] takes at once (a leaf's cells).
+pub(crate) const MANY: usize = 16;
+
 /// Bins per side of each face of the cube map of climb starts.
 const START_BINS: usize = 64;
 
@@ -270,7 +273,13 @@ impl ConvexHull {
             let at = (entry & !EXACT) as usize;
             return (dir.dot(self.points[at]), at);
         }
-        let mut at = entry as usize;
+        let at = entry as usize;
+        self.climb_from(dir, at)
+    }
+
+    /// Hill climbing along `dir` from vertex `at`.
+    #[inline]
+    fn climb_from(&self, dir: Vector, mut at: usize) -> (Real, usize) {
         let mut best = dir.dot(self.points[at]);
         loop {
             let mut moved = false;
@@ -286,6 +295,19 @@ impl ConvexHull {
             if !moved {
                 return (best, at);
             }
+        }
+    }
+
+    /// [`ConvexHull::climb`] for several directions (at most [`MANY`]): every cube-map bin is read
+    /// before any is used, so that the memory waits of the run overlap.
+    #[inline]
+    fn climb_many(&self, dirs: &[Vector], out: &mut [Real]) {
+        let mut entries = [0u16; MANY];
+        for (e, d) in entries.iter_mut().zip(dirs) {
+            *e = self.starts.get(start_bin(*d)).copied().unwrap_or(0);
+        }
+        for ((e, d), o) in entries.iter().zip(dirs).zip(out) {
+            *o = if e & EXACT != 0 { d.dot(self.points[(e & !EXACT) as usize]) } else { self.climb_from(*d, *e as usize).0 };
         }
     }
 
@@ -359,6 +381,21 @@ impl TargetShape {
         match self {
             TargetShape::Polytope(h) if h.points.len() >= CLIMB_MIN_POINTS => h.climb(dir),
             _ => self.project(dir)[1],
+        }
+    }
+
+    /// `max dir . x` for each of `dirs` (at most [`MANY`]) into `out`. For a hull, the run's
+    /// cube-map reads are issued together: one by one, each query waited on its bin (at 1M cells
+    /// the map falls out of the nearest caches between queries).
+    #[inline]
+    pub(crate) fn support_many(&self, dirs: &[Vector], out: &mut [Real]) {
+        match self {
+            TargetShape::Polytope(h) if h.points.len() >= CLIMB_MIN_POINTS && dirs.len() <= MANY => h.climb_many(dirs, out),
+            _ => {
+                for (d, o) in dirs.iter().zip(out) {
+                    *o = self.support(*d);
+                }
+            }
         }
     }
 
