@@ -209,7 +209,9 @@ impl RecentAxes {
 /// the `recent` axes or the line between the two centroids separates the pair (that line is then
 /// remembered), `Some(true)` when the cell's centroid lies strictly inside the target (then the
 /// interiors meet, and the exact SAT would find overlap on every axis), `None` when only the full
-/// test can tell.
+/// test can tell. For hulls only the `recent` axes are tried: the GJK that follows (see
+/// `scene::decide`) settles the rest for a few support queries, where the centroid test alone
+/// could read all of a hull's 300 faces (measured 2 % faster on the Panda benchmark without them).
 ///
 /// A link pushed through a surface meets thousands of cells; most of those the search must
 /// decide are either beside the link (one of a few axes separates them) or wholly inside it, and
@@ -219,6 +221,9 @@ pub(crate) fn quick_decide(view: &TargetView, cell: &ThicknessCell, recent: &mut
     let verts = cell.vertices();
     if recent.separate_points(&verts) {
         return Some(false);
+    }
+    if matches!(view.target.shape, TargetShape::Polytope(_)) {
+        return None;
     }
     let centroid = verts.iter().copied().sum::<Vector>() / 6.0;
     let between = centroid - view.centre;

@@ -357,9 +357,11 @@ fn decide(view: &TargetView, cell: &ThicknessCell, recent: &mut RecentAxes, need
         Some(true) if !need_sat => return (true, None),
         _ => {}
     }
-    if let (TargetShape::Polytope(hull), false) = (&view.target.shape, need_sat) {
+    if let TargetShape::Polytope(hull) = &view.target.shape {
         match gjk::hull_cell(hull, &cell.vertices().map(|v| view.object_in_target * v)) {
-            Verdict::Overlap => return (true, None),
+            // With `need_sat` the SAT below confirms it and gives the least overlap.
+            Verdict::Overlap if !need_sat => return (true, None),
+            Verdict::Overlap => {}
             Verdict::Apart(axis) => {
                 // The axis is in the target's frame.
                 let axis = view.object_in_target.rotation.inverse() * axis.normalize();
