@@ -170,7 +170,7 @@ impl Scene {
                     }
                     for (index, slab) in tree.leaf_cells(node) {
                         report.candidates += 1;
-                        if !CellTree::slab_meets_target_box(slab, &view) || recent.separate_box(slab.centre, slab.half) {
+                        if !CellTree::slab_meets_target_box(slab, &view) || recent.separate_box(slab.centre(), slab.half()) {
                             continue;
                         }
                         let Some((push, depth)) = normal_axis_deeper(target, slab, side, &view.rotation, pos12.translation, Real::NEG_INFINITY) else { continue };
@@ -308,7 +308,7 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
             if slab.depth_bound(&leaf) <= best_depth + DEPTH_TOLERANCE {
                 continue;
             }
-            if !CellTree::slab_meets_target_box(slab, view) || recent.separate_box(slab.centre, slab.half) {
+            if !CellTree::slab_meets_target_box(slab, view) || recent.separate_box(slab.centre(), slab.half()) {
                 continue;
             }
             let axis = NormalAxis::new(view.target, slab, area.side, &view.rotation, view.object_in_target.translation);
