@@ -10,8 +10,10 @@
 //! leaf answers for the whole plane. Boxes are also compared in the target's own frame (an
 //! oriented-box test on three axes), which drops most of what a tilted link's world box takes in.
 //!
-//! Leaves hold 16 cells: on the Panda benchmark at 1M triangles, 4 and 8 were slower (more nodes
-//! to bound) and 32 too (more cells to test).
+//! Leaves hold 32 cells: on the Panda benchmark at 1M triangles, 4 and 8 were slower than 16 (more
+//! nodes to bound); once a leaf's support queries were made together (their memory waits
+//! overlapping), 32 beat 16 by 4 % (two trees in one process, runs interleaved), and 48 was no
+//! better.
 
 use super::target::Target;
 use crate::math::{Aabb, Pose, Real, Vector};
@@ -19,7 +21,7 @@ use crate::thickness::{Side, ThicknessCell};
 use parry3d_f64::math::Matrix;
 
 /// Cells per leaf.
-const LEAF_CELLS: usize = 16;
+const LEAF_CELLS: usize = 32;
 
 /// Slack when a node's slab is compared with the target: rounding must never prune a node whose
 /// cells the exact per-cell test would keep.
@@ -401,7 +403,7 @@ impl CellTree {
     }
 
     /// Asks the memory system for what a search reads when it pops `node`, ahead of that pop: a
-    /// leaf's slabs (1.6 kB), or an inner node's two children. At 1M cells these loads missed
+    /// leaf's slabs (2.5 kB), or an inner node's two children. At 1M cells these loads missed
     /// every cache, and the search then waited on each in turn (prefetching both took the Panda
     /// benchmark's full check from 125 to 111 us per state). Only a hint: a no-op off x86-64.
     #[inline]

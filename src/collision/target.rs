@@ -52,8 +52,9 @@ pub struct ConvexHull {
 /// Below this many vertices a linear scan beats hill climbing.
 const CLIMB_MIN_POINTS: usize = 24;
 
-/// The most directions [`TargetShape::support_many`] takes at once (a leaf's cells).
-pub(crate) const MANY: usize = 16;
+/// The most directions [`TargetShape::support_many`] takes at once (a leaf's cells: `LEAF_CELLS`
+/// in `cell_tree`).
+pub(crate) const MANY: usize = 32;
 
 /// Bins per side of each face of the cube map of climb starts.
 const START_BINS: usize = 64;
