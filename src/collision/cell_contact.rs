@@ -104,7 +104,7 @@ pub(crate) fn normal_axis_deeper(target: &Target, cell: &CellSlab, side: Side, r
 /// [`normal_axis_deeper`] in two steps, so that a leaf's support queries can be made together
 /// (see [`TargetShape::support_many`](super::target::TargetShape::support_many)): the cell's
 /// normal in the target's frame, its range on it, and which end of the target gives the depth.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct NormalAxis {
     n: Vector,
     b_min: Real,

@@ -23,6 +23,9 @@ use parry3d_f64::math::Matrix;
 /// Cells per leaf.
 const LEAF_CELLS: usize = 32;
 
+// A leaf's support queries are made in one call (see `scene::deepest_search`).
+const _: () = assert!(LEAF_CELLS <= super::target::MANY);
+
 /// Slack when a node's slab is compared with the target: rounding must never prune a node whose
 /// cells the exact per-cell test would keep.
 const SLAB_SLACK: Real = 1e-10;
@@ -201,23 +204,29 @@ impl<'a> TargetView<'a> {
     /// target's own box (outside the exact extent): one support query where two were.
     #[inline]
     pub fn depth_extent_along(&self, dir: Vector) -> [Real; 2] {
-        let d = self.rotation * dir;
-        let shift = d.dot(self.object_in_target.translation);
-        let b = &self.local_aabb;
-        let c = d.dot((b.mins + b.maxs) * 0.5);
-        let r = d.abs().dot((b.maxs - b.mins) * 0.5);
-        match self.side {
-            Side::Back => [-self.target.shape.support(-d) - shift, c + r - shift],
-            Side::Front => [c - r - shift, self.target.shape.support(d) - shift],
-            Side::Both => self.target.shape.project(d).map(|x| x - shift),
-        }
+        let (d, query) = self.depth_query(dir);
+        self.depth_extent_from(d, query.map_or(0.0, |q| self.target.shape.support(q)))
     }
 
-    /// [`TargetView::depth_extent_along`] given the support query it makes (`support(-d)` for
-    /// `back`, `support(d)` for `front`, with `d` the direction in the target's frame).
+    /// `dir` in the target's frame, and the one support query [`TargetView::depth_extent_along`]
+    /// makes: along it negated for `back` (its support gives the minimum), along it for `front`,
+    /// none for `both` (both ends are queried in [`TargetView::depth_extent_from`]).
     #[inline]
-    pub fn depth_extent_from(&self, dir: Vector, support: Real) -> [Real; 2] {
+    pub fn depth_query(&self, dir: Vector) -> (Vector, Option<Vector>) {
         let d = self.rotation * dir;
+        let query = match self.side {
+            Side::Back => Some(-d),
+            Side::Front => Some(d),
+            Side::Both => None,
+        };
+        (d, query)
+    }
+
+    /// [`TargetView::depth_extent_along`] for `d`, the direction already in the target's frame,
+    /// given the support along [`TargetView::depth_query`] (unused for `both`, which queries
+    /// both ends here).
+    #[inline]
+    pub fn depth_extent_from(&self, d: Vector, support: Real) -> [Real; 2] {
         let shift = d.dot(self.object_in_target.translation);
         let b = &self.local_aabb;
         let c = d.dot((b.mins + b.maxs) * 0.5);
@@ -354,7 +363,7 @@ impl CellTree {
         let mut b = Builder { cells, boxes, nodes: Vec::with_capacity(2 * cells.len() / LEAF_CELLS + 2), order };
         let _ = b.build(0, cells.len());
         let (nodes, order) = (b.nodes, b.order);
-        let sorted: Vec<ThicknessCell> = order.iter().map(|(_, i)| cells[*i as usize].clone()).collect();
+        let sorted: Vec<ThicknessCell> = order.iter().map(|(_, i)| cells[*i as usize]).collect();
         *cells = sorted;
         let mut slabs: Vec<CellSlab> = cells.iter().map(CellSlab::of).collect();
         let mut nodes = nodes;
@@ -477,20 +486,19 @@ impl CellTree {
             }
             return out;
         }
-        let (mut dirs, mut which, mut count) = ([Vector::ZERO; 2], [0usize; 2], 0);
+        let (mut dirs, mut queries, mut which, mut count) = ([Vector::ZERO; 2], [Vector::ZERO; 2], [0usize; 2], 0);
         for k in 0..2 {
             if keep[k] && self.boxes_meet(nodes[k], view) {
-                let d = view.rotation * self.nodes[nodes[k] as usize].axis;
-                dirs[count] = if matches!(view.side, Side::Back) { -d } else { d };
-                which[count] = k;
+                let (d, query) = view.depth_query(self.nodes[nodes[k] as usize].axis);
+                // `back` or `front` here (`both` went above): the query is there.
+                (dirs[count], queries[count], which[count]) = (d, query.unwrap_or(d), k);
                 count += 1;
             }
         }
         let mut supports = [0.0; 2];
-        view.target.shape.support_many(&dirs[..count], &mut supports[..count]);
+        view.target.shape.support_many(&queries[..count], &mut supports[..count]);
         for j in 0..count {
-            let node = nodes[which[j]];
-            out[which[j]] = self.bound_from(node, view, view.depth_extent_from(self.nodes[node as usize].axis, supports[j]));
+            out[which[j]] = self.bound_from(nodes[which[j]], view, view.depth_extent_from(dirs[j], supports[j]));
         }
         out
     }

@@ -246,8 +246,9 @@ struct Pending(Real, u32);
 /// skipped when its bound cannot beat the deepest collision found. (A best-first search with a
 /// heap, which stops at the first bound that cannot, measured 2 % slower on the Panda benchmark:
 /// with these bounds it expands nearly the same nodes, and pays for the heap.) Pairs are decided by
-/// [`quick_decide`] where it can; with `least_overlap` the winner's full SAT gives its least
-/// overlap (and, were it to disagree with the quick test, the search is run again without it).
+/// [`decide`]'s quick tests and GJK where they can; with `least_overlap` the winner's full SAT
+/// gives its least overlap (and, were it to disagree with them, the search is run again with the
+/// SAT alone deciding).
 fn deepest_cell(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candidates: &mut usize, least_overlap: bool) -> Option<(Real, u32, Vector, Option<SatOverlap>)> {
     let (depth, leaf, push, sat) = deepest_search(tree, area, view, candidates, true)?;
     if sat.is_some() || !least_overlap {
@@ -256,7 +257,7 @@ fn deepest_cell(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candid
     if let Some(sat) = LocalPair::new(view.target, &area.cells[leaf as usize], &view.object_in_target).sat() {
         return Some((depth, leaf, push, Some(sat)));
     }
-    // The centroid test and the SAT disagreed (rounding on a razor-thin overlap): search again
+    // A quick verdict and the SAT disagreed (rounding on a razor-thin overlap): search again
     // with the SAT alone deciding.
     deepest_search(tree, area, view, candidates, false)
 }
@@ -299,8 +300,9 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
         }
         leaf_hits.clear();
         let leaf = tree.leaf_view(node, view);
-        // The cells that pass their bound and boxes, then their support queries together.
-        let mut axes = [(0u32, None::<NormalAxis>); MANY];
+        // The cells that pass their bound and boxes, then their support queries together (a
+        // leaf holds at most MANY cells: `cell_tree` asserts it).
+        let mut axes = [(0u32, NormalAxis::default()); MANY];
         let mut dirs = [Vector::ZERO; MANY];
         let mut count = 0;
         for (index, slab) in tree.leaf_cells(node) {
@@ -312,21 +314,14 @@ fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, cand
                 continue;
             }
             let axis = NormalAxis::new(view.target, slab, area.side, &view.rotation, view.object_in_target.translation);
-            if count == MANY {
-                // Leaves hold at most MANY cells; were one larger, its extra cells go one by one.
-                if let Some((push, depth)) = axis.finish(view.target, view.target.shape.support(axis.first_query()), best_depth + DEPTH_TOLERANCE) {
-                    leaf_hits.push((depth, index, push));
-                }
-                continue;
-            }
             dirs[count] = axis.first_query();
-            axes[count] = (index, Some(axis));
+            axes[count] = (index, axis);
             count += 1;
         }
         let mut supports = [0.0; MANY];
         view.target.shape.support_many(&dirs[..count], &mut supports[..count]);
         for ((index, axis), first) in axes[..count].iter().zip(supports) {
-            if let Some((push, depth)) = axis.and_then(|a| a.finish(view.target, first, best_depth + DEPTH_TOLERANCE)) {
+            if let Some((push, depth)) = axis.finish(view.target, first, best_depth + DEPTH_TOLERANCE) {
                 leaf_hits.push((depth, *index, push));
             }
         }
@@ -357,27 +352,27 @@ fn decide(view: &TargetView, cell: &ThicknessCell, recent: &mut RecentAxes, need
         Some(true) if !need_sat => return (true, None),
         _ => {}
     }
+    // A separating axis (target frame) found below, kept for the neighbouring cells.
+    let mut remember = |axis: Vector| {
+        let axis = view.object_in_target.rotation.inverse() * axis;
+        recent.remember(axis, view.extent_along(axis));
+    };
     if let TargetShape::Polytope(hull) = &view.target.shape {
         match gjk::hull_cell(hull, &cell.vertices().map(|v| view.object_in_target * v)) {
             // With `need_sat` the SAT below confirms it and gives the least overlap.
             Verdict::Overlap if !need_sat => return (true, None),
-            Verdict::Overlap => {}
+            Verdict::Overlap | Verdict::Unknown => {}
             Verdict::Apart(axis) => {
-                // The axis is in the target's frame.
-                let axis = view.object_in_target.rotation.inverse() * axis.normalize();
-                recent.remember(axis, view.extent_along(axis));
+                remember(axis.normalize());
                 return (false, None);
             }
-            Verdict::Unknown => {}
         }
     }
     match LocalPair::new(view.target, cell, &view.object_in_target).sat_or_axis() {
         Ok(sat) => (true, Some(sat)),
         Err(separating) => {
             if let Some(axis) = separating {
-                // The SAT's axis is in the target's frame.
-                let axis = view.object_in_target.rotation.inverse() * axis;
-                recent.remember(axis, view.extent_along(axis));
+                remember(axis);
             }
             (false, None)
         }

@@ -86,33 +86,22 @@ fn cube_direction(face: usize, u: Real, v: Real) -> Vector {
     }
 }
 
-/// The cube map of [`ConvexHull::starts`]. A bin's directions are the positive combinations of
-/// its four corner directions, and the directions along which a vertex is extreme form a convex
-/// cone: when one vertex is the unique extreme at all four corners, it is at every direction of
-/// the bin.
-fn support_cube_map(points: &[Vector], first: &[u32], adjacent: &[u32]) -> Vec<u16> {
+/// The cube map of [`ConvexHull::starts`], for a hull whose map is still empty. A bin's directions
+/// are the positive combinations of its four corner directions, and the directions along which a
+/// vertex is extreme form a convex cone: when one vertex is the unique extreme at all four
+/// corners, it is at every direction of the bin.
+fn support_cube_map(hull: &ConvexHull) -> Vec<u16> {
     let n = START_BINS;
     let grid = |i: usize| i as Real / n as Real * 2.0 - 1.0;
-    // The extreme vertex along `dir` by hill climbing from `start`, and whether it is unique (by
+    // The extreme vertex along `dir`, climbing from the last one, and whether it is unique (by
     // more than rounding): the maximisers of a convex polytope form a face, so a tie would show
     // at a neighbour.
     let mut at = 0usize;
     let mut extreme = |dir: Vector| {
-        let mut best = dir.dot(points[at]);
-        loop {
-            let mut moved = false;
-            for &nb in &adjacent[first[at] as usize..first[at + 1] as usize] {
-                let d = dir.dot(points[nb as usize]);
-                if d > best {
-                    (best, at, moved) = (d, nb as usize, true);
-                }
-            }
-            if !moved {
-                break;
-            }
-        }
+        let (best, end) = hull.climb_from(dir, at);
+        at = end;
         let margin = 1e-12 * (1.0 + best.abs());
-        let unique = adjacent[first[at] as usize..first[at + 1] as usize].iter().all(|&nb| dir.dot(points[nb as usize]) < best - margin);
+        let unique = hull.neighbours(at).iter().all(|&nb| dir.dot(hull.points[nb as usize]) < best - margin);
         (at as u16, unique)
     };
     let mut starts = Vec::with_capacity(6 * n * n);
@@ -206,9 +195,12 @@ impl ConvexHull {
             adjacency.extend_from_slice(n);
             adjacency_first[i + 1] = adjacency.len() as u32;
         }
-        let starts = if points.len() >= CLIMB_MIN_POINTS && points.len() < EXACT as usize { support_cube_map(&points, &adjacency_first, &adjacency) } else { Vec::new() };
         let radius = points.iter().map(|p| (*p - centroid).length()).fold(0.0, Real::max);
-        Some(ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), adjacency_first, adjacency, starts, parry })
+        let mut hull = ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), adjacency_first, adjacency, starts: Vec::new(), parry };
+        if hull.points.len() >= CLIMB_MIN_POINTS && hull.points.len() < EXACT as usize {
+            hull.starts = support_cube_map(&hull);
+        }
+        Some(hull)
     }
 
     /// The hull grown by `padding` metres: every vertex moved out along the normal of each of its
@@ -268,14 +260,29 @@ impl ConvexHull {
     /// [`ConvexHull::climb`] and the vertex it ends at.
     #[inline]
     fn climb_vertex(&self, dir: Vector) -> (Real, usize) {
-        // No map on a hull of 2^15 vertices or more: climb from vertex 0.
-        let entry = self.starts.get(start_bin(dir)).copied().unwrap_or(0);
+        self.from_entry(dir, self.entry(dir))
+    }
+
+    /// The cube-map entry of `dir`; with no map (a hull of `2^15` vertices or more), vertex 0.
+    #[inline]
+    fn entry(&self, dir: Vector) -> u16 {
+        self.starts.get(start_bin(dir)).copied().unwrap_or(0)
+    }
+
+    /// The extreme along `dir` from its cube-map entry: the flagged vertex, or a climb from it.
+    #[inline]
+    fn from_entry(&self, dir: Vector, entry: u16) -> (Real, usize) {
         if entry & EXACT != 0 {
             let at = (entry & !EXACT) as usize;
             return (dir.dot(self.points[at]), at);
         }
-        let at = entry as usize;
-        self.climb_from(dir, at)
+        self.climb_from(dir, entry as usize)
+    }
+
+    /// The vertices that share a face with vertex `at`.
+    #[inline]
+    fn neighbours(&self, at: usize) -> &[u32] {
+        &self.adjacency[self.adjacency_first[at] as usize..self.adjacency_first[at + 1] as usize]
     }
 
     /// Hill climbing along `dir` from vertex `at`.
@@ -284,8 +291,7 @@ impl ConvexHull {
         let mut best = dir.dot(self.points[at]);
         loop {
             let mut moved = false;
-            let (s, e) = (self.adjacency_first[at] as usize, self.adjacency_first[at + 1] as usize);
-            for &nb in &self.adjacency[s..e] {
+            for &nb in self.neighbours(at) {
                 let d = dir.dot(self.points[nb as usize]);
                 if d > best {
                     best = d;
@@ -305,10 +311,10 @@ impl ConvexHull {
     fn climb_many(&self, dirs: &[Vector], out: &mut [Real]) {
         let mut entries = [0u16; MANY];
         for (e, d) in entries.iter_mut().zip(dirs) {
-            *e = self.starts.get(start_bin(*d)).copied().unwrap_or(0);
+            *e = self.entry(*d);
         }
         for ((e, d), o) in entries.iter().zip(dirs).zip(out) {
-            *o = if e & EXACT != 0 { d.dot(self.points[(e & !EXACT) as usize]) } else { self.climb_from(*d, *e as usize).0 };
+            *o = self.from_entry(*d, *e).0;
         }
     }
 
