@@ -9,7 +9,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-use thickness_collision::checker::{Checker, JointMemory};
+use thickness_collision::checker::Checker;
 use thickness_collision::collision::{Scene, TargetShape};
 use thickness_collision::math::{Pose, Real};
 use thickness_collision::mesh::{MeshTopology, TopologySettings};
@@ -114,15 +114,13 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
     let started = Instant::now();
     let mut reports = Vec::with_capacity(states.len());
     for (names, pos) in states {
-        let mut memory = JointMemory::new(&checker.robot);
-        reports.push(checker.check_joints(names, pos, &mut memory, true).unwrap().0);
+        reports.push(checker.check_joints(names, pos).unwrap());
     }
     let ours_seconds = started.elapsed().as_secs_f64();
     // Like for like with the peers' boolean collide: which links collide, first cell wins.
     let started = Instant::now();
     for ((names, pos), full) in states.iter().zip(&reports) {
-        let mut memory = JointMemory::new(&checker.robot);
-        let flags = checker.check_joints_flags(names, pos, &mut memory).unwrap();
+        let flags = checker.check_joints_flags(names, pos).unwrap();
         let (a, b): (Vec<&str>, Vec<&str>) = (flags.contacts.iter().map(|c| c.link_name.as_str()).collect(), full.contacts.iter().map(|c| c.link_name.as_str()).collect());
         assert_eq!(a, b, "flag-only and full checks must agree on the colliding links");
     }
@@ -137,7 +135,7 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
 
     // The parts (every link's convex pieces) and their world poses per state.
     let mut parts: Vec<(usize, std::sync::Arc<thickness_collision::collision::ConvexHull>, Pose)> = Vec::new();
-    for (ti, t) in checker.targets.iter().enumerate() {
+    for (ti, t) in checker.targets().iter().enumerate() {
         for (shape, offset) in &t.parts {
             match shape {
                 TargetShape::Polytope(h) => parts.push((ti, h.clone(), *offset)),
@@ -165,13 +163,13 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
     let mut poses: Vec<f64> = Vec::with_capacity(states.len() * parts.len() * 12);
     let mut link_poses = Vec::with_capacity(states.len());
     for (names, pos) in states {
-        let mut q = vec![0.0; checker.robot.joints.len()];
+        let mut q = vec![0.0; checker.robot().joints.len()];
         for (n, p) in names.iter().zip(pos) {
-            q[checker.robot.joint(n).unwrap()] = *p;
+            q[checker.robot().joint(n).unwrap()] = *p;
         }
-        let world_links: Vec<Pose> = checker.robot.forward_kinematics(&q, &nalgebra::Isometry3::identity()).iter().map(thickness_collision::math::pose_from_isometry).collect();
+        let world_links: Vec<Pose> = checker.robot().forward_kinematics(&q, &nalgebra::Isometry3::identity()).unwrap().iter().map(thickness_collision::math::pose_from_isometry).collect();
         for (ti, _, offset) in &parts {
-            let p = world_links[checker.targets[*ti].link] * *offset;
+            let p = world_links[checker.targets()[*ti].link] * *offset;
             let m = glam::DMat3::from_quat(p.rotation);
             for r in 0..3 {
                 for c in 0..3 {
@@ -220,7 +218,7 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
             if peer == "coal" && row.contains(&b'1') {
                 cmp.coal_colliding_states += 1;
             }
-            for (ti, t) in checker.targets.iter().enumerate() {
+            for (ti, t) in checker.targets().iter().enumerate() {
                 let theirs = parts.iter().enumerate().any(|(pi, (pt, _, _))| *pt == ti && row[pi] == b'1');
                 let contact = report.contacts.iter().find(|c| c.link_name == t.name);
                 if contact.is_some() == theirs {
@@ -240,7 +238,7 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
                 match contact {
                     // Ours only: explained when parry's GJK confirms the link meets the reported cell.
                     Some(c) => {
-                        let object = checker.scene.objects().iter().find(|o| o.name == c.object_name).unwrap();
+                        let object = checker.scene().objects().iter().find(|o| o.name == c.object_name).unwrap();
                         let cell = object.area().unwrap().cells.iter().find(|cell| cell.triangle == c.triangle).unwrap();
                         let poly = ConvexPolyhedron::from_convex_hull(&cell.distinct_vertices()).unwrap();
                         let meets = parts.iter().filter(|(pt, _, _)| *pt == ti).any(|(_, hull, off)| {

@@ -11,8 +11,9 @@ use std::path::Path;
 use std::time::Instant;
 use thickness_collision::checker::Checker;
 use thickness_collision::model::Params;
-use thickness_collision::msgs::{encode_cdr_le, Header, JointState, Time};
-use thickness_collision::replay::{replay, PoseSource, ReplayOptions};
+use thickness_collision::msgs::{Header, JointState, Time};
+use thickness_collision::replay::encode_cdr_le;
+use thickness_collision::replay::{replay, ReplayOptions};
 
 const STATES: usize = 100_000;
 
@@ -42,7 +43,7 @@ fn main() {
     let mut rng = Rand64::new(42);
     let states: Vec<(Vec<String>, Vec<f64>)> = (0..STATES)
         .map(|_| {
-            let joints: Vec<_> = checker.robot.joints.iter().filter(|j| j.is_actuated()).collect();
+            let joints: Vec<_> = checker.robot().joints.iter().filter(|j| j.is_actuated()).collect();
             let names = joints.iter().map(|j| j.name.clone()).collect();
             let pos = joints.iter().map(|j| { let (lo, hi) = (j.limits[0].max(-3.0), j.limits[1].min(3.0)); lo + (hi - lo) * rng.rand_float() }).collect();
             (names, pos)
@@ -60,7 +61,8 @@ fn main() {
         let opts = ReplayOptions {
             bag: bag.clone(),
             topic: None,
-            pose_source: PoseSource::JointStates,
+            pose_source: None,
+            frame_prefix: None,
             out_dir: out.then(|| root.join(format!("out_{}", label.len()))),
             jsonl: jsonl.then(|| root.join("out.jsonl")),
             start: None,

@@ -6,7 +6,9 @@
 //! and checks convex robot links against the cells with a separating-axis test behind a BVH.
 //!
 //! The layers point one way: [`mesh`] (topology) ← [`thickness`] (cells) ← [`collision`]
-//! (targets, SAT, scene) ← [`model`] (files). The geometry core knows nothing of files or ROS.
+//! (targets, SAT, scene) ← [`model`] (files) ← [`checker`] (a robot state against the scene) ←
+//! [`pipeline`] (messages to checked states) ← the front doors: the node (`ros`), [`replay`] and
+//! the CLI. The geometry core knows nothing of files or ROS; [`msgs`] are plain serde types.
 #![warn(missing_docs)]
 #![deny(unused_results)]
 
@@ -16,6 +18,7 @@ pub mod math;
 pub mod mesh;
 pub mod model;
 pub mod msgs;
+pub mod pipeline;
 pub mod replay;
 #[cfg(feature = "ros")]
 pub mod ros;

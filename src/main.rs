@@ -6,7 +6,17 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use thickness_collision::model::PoseSource;
 use thickness_collision::thickness::Side;
+
+// The core's enums parse themselves (FromStr); the CLI only names them.
+fn parse_side(s: &str) -> Result<Side, String> {
+    s.parse()
+}
+
+fn parse_pose_source(s: &str) -> Result<PoseSource, String> {
+    s.parse()
+}
 
 #[derive(Parser)]
 #[command(name = "thickness_collision", version, about = "Collision checking against thin surfaces with thickness areas")]
@@ -24,8 +34,8 @@ enum Command {
         /// Thickness of every cell (metres).
         #[arg(long, allow_negative_numbers = true)]
         thickness: f64,
-        /// Where the volume goes relative to each face's front normal.
-        #[arg(long, value_enum, default_value_t = Side::Back)]
+        /// Where the volume goes relative to each face's front normal: back, front or both.
+        #[arg(long, default_value = "back", value_parser = parse_side)]
         side: Side,
         /// Scale applied to the file's coordinates: one factor, or three as `sx,sy,sz`.
         #[arg(long, default_value = "1")]
@@ -41,8 +51,9 @@ enum Command {
         /// One state: `joint=value,joint=value,...` (radians / metres).
         #[arg(long, conflicts_with = "states", required_unless_present_any = ["states", "show_params"])]
         joints: Option<String>,
-        /// A JSON-lines file of states: `{"name": [...], "position": [...]}` or
-        /// `{"transforms": [{"link": ..., "translation": [x,y,z], "rotation": [x,y,z,w]}]}`.
+        /// A JSON-lines file of states, in order, through the node's pipeline: `{"name": [...],
+        /// "position": [...]}` or `{"transforms": [{"link": ..., "translation": [x,y,z],
+        /// "rotation": [x,y,z,w]}]}`, each with an optional `"stamp"` (integer nanoseconds).
         #[arg(long)]
         states: Option<PathBuf>,
         /// One JSON object per state on standard output.
@@ -70,9 +81,12 @@ enum Command {
         /// Input topic (default /joint_states, or /tf with --pose-source tf).
         #[arg(long)]
         topic: Option<String>,
-        /// Where robot states come from.
-        #[arg(long, value_enum, default_value_t = thickness_collision::replay::PoseSource::JointStates)]
-        pose_source: thickness_collision::replay::PoseSource,
+        /// Where robot states come from: joint_states or tf (default: the parameters' pose_source).
+        #[arg(long, value_parser = parse_pose_source)]
+        pose_source: Option<PoseSource>,
+        /// The robot's frame prefix on /tf (default: the parameters' frame_prefix).
+        #[arg(long)]
+        frame_prefix: Option<String>,
         /// Write a rosbag2 bag (metadata.yaml + .mcap) with the `collisions` topic here.
         #[arg(long = "out")]
         out_dir: Option<PathBuf>,
@@ -104,8 +118,8 @@ pub struct ModelArgs {
     /// Thickness of every thin surface (metres), overriding the parameters.
     #[arg(long, allow_negative_numbers = true)]
     thickness: Option<f64>,
-    /// Side of every thin surface, overriding the parameters.
-    #[arg(long, value_enum)]
+    /// Side of every thin surface (back, front or both), overriding the parameters.
+    #[arg(long, value_parser = parse_side)]
     side: Option<Side>,
 }
 
@@ -126,8 +140,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Check { model, joints, states, json, show_params } => cli::check::check(&model, joints.as_deref(), states.as_deref(), json, show_params),
         #[cfg(feature = "ros")]
         Command::Run { model, ros_args } => cli::run::run(&model, &ros_args),
-        Command::Replay { bag, model, topic, pose_source, out_dir, jsonl, start, end } => {
-            let opts = thickness_collision::replay::ReplayOptions { bag, topic, pose_source, out_dir, jsonl, start, end, progress: true };
+        Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, jsonl, start, end } => {
+            let opts = thickness_collision::replay::ReplayOptions { bag, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, progress: true };
             cli::replay::replay(&model, &opts)
         }
     }

@@ -80,8 +80,11 @@ fn thickness_and_side_override_the_parameters() {
     // guard sheet (surface between x = 0.54 and 0.56, front towards -x).
     let states = tmp("behind.jsonl");
     std::fs::write(&states, r#"{"transforms": [{"link": "wrist_1_link", "translation": [0.62, 0.0, 0.4], "rotation": [0, 0, 0, 1]}]}"#).unwrap();
+    // Only the wrist is checked: a transforms line must place every checked link.
+    let params = tmp("wrist_only.yaml");
+    std::fs::write(&params, "thickness_collision:\n  ros__parameters:\n    checked_links: [wrist_1_link]\n").unwrap();
     let hit = |extra: &[&str]| -> bool {
-        let out = ok(bin().args(["check", "--states", states.to_str().unwrap(), "--json"]).args(extra).output().unwrap());
+        let out = ok(bin().args(["check", "--params-file", params.to_str().unwrap(), "--states", states.to_str().unwrap(), "--json"]).args(extra).output().unwrap());
         serde_json::from_str::<serde_json::Value>(out.trim()).unwrap()["in_collision"].as_bool().unwrap()
     };
     assert!(hit(&[]), "default 2 cm reaches it");
@@ -89,6 +92,14 @@ fn thickness_and_side_override_the_parameters() {
     assert!(!hit(&["--thickness", "0.005"]), "5 mm does not");
     assert!(!hit(&["--side", "front"]), "front cells lie on the other side");
     assert!(hit(&["--side", "both"]));
+    // With every link checked, the other links' poses are unknown: not checked, reported in
+    // collision with the cause, exit 2.
+    let out = bin().args(["check", "--states", states.to_str().unwrap(), "--json"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let v: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
+    assert_eq!(v["in_collision"], true);
+    assert!(v["error"].as_str().unwrap().contains("does not reach world_frame"), "{v}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("line 1"));
 }
 
 #[test]

@@ -26,20 +26,20 @@ fn real_robots_load_and_every_link_gets_targets() {
         "talos_data/robots/talos_full_v2.urdf",    // negative mesh scales
     ] {
         let (checker, _, _) = load(rel);
-        let with_geometry: Vec<&str> = checker.robot.links.iter().filter(|l| !l.geometry.is_empty()).map(|l| l.name.as_str()).collect();
+        let with_geometry: Vec<&str> = checker.robot().links.iter().filter(|l| !l.geometry.is_empty()).map(|l| l.name.as_str()).collect();
         assert!(!with_geometry.is_empty(), "{rel}");
-        assert_eq!(checker.targets.len(), with_geometry.len(), "{rel}: every link with geometry is checked");
-        for t in &checker.targets {
-            assert_eq!(t.parts.len(), checker.robot.links[t.link].geometry.len(), "{rel}: {}", t.name);
+        assert_eq!(checker.targets().len(), with_geometry.len(), "{rel}: every link with geometry is checked");
+        for t in checker.targets() {
+            assert_eq!(t.parts.len(), checker.robot().links[t.link].geometry.len(), "{rel}: {}", t.name);
         }
-        eprintln!("{rel}: {} links, {} with targets, {} meshes read", checker.robot.links.len(), checker.targets.len(), checker.summary.meshes_read);
+        eprintln!("{rel}: {} links, {} with targets, {} meshes read", checker.robot().links.len(), checker.targets().len(), checker.summary().meshes_read);
     }
 }
 
 #[test]
 fn solo12_binary_stl_with_solid_header_is_read() {
     let (checker, _, _) = load("solo_description/robots/solo12.urdf");
-    let header_is_solid = checker.robot.links.iter().flat_map(|l| &l.geometry).any(|g| match &g.spec {
+    let header_is_solid = checker.robot().links.iter().flat_map(|l| &l.geometry).any(|g| match &g.spec {
         thickness_collision::model::GeometrySpec::Mesh { path, .. } => std::fs::read(path).map(|b| b.starts_with(b"solid") && b.len() == 84 + 50 * u32::from_le_bytes([b[80], b[81], b[82], b[83]]) as usize).unwrap_or(false),
         _ => false,
     });
@@ -49,7 +49,7 @@ fn solo12_binary_stl_with_solid_header_is_read() {
 #[test]
 fn talos_negative_scales_are_mirrored() {
     let (checker, _, _) = load("talos_data/robots/talos_full_v2.urdf");
-    let mirrored = checker.robot.links.iter().flat_map(|l| &l.geometry).filter(|g| matches!(&g.spec, thickness_collision::model::GeometrySpec::Mesh { scale, .. } if scale.iter().product::<f64>() < 0.0)).count();
+    let mirrored = checker.robot().links.iter().flat_map(|l| &l.geometry).filter(|g| matches!(&g.spec, thickness_collision::model::GeometrySpec::Mesh { scale, .. } if scale.iter().product::<f64>() < 0.0)).count();
     assert!(mirrored > 0);
 }
 
@@ -74,7 +74,7 @@ fn fk_matches_yourdfpy(urdf: &std::path::Path, map: &[String], seed: u64) {
             let _ = cfg.insert(j.name.clone(), json!(q[i]));
         }
         configs.push(serde_json::Value::Object(cfg));
-        ours.push(model.forward_kinematics(&q, &Isometry3::identity()));
+        ours.push(model.forward_kinematics(&q, &Isometry3::identity()).unwrap());
     }
     let theirs = common::run_peer("fk_yourdfpy.py", &json!({"urdf": urdf, "links": links, "configs": configs}));
     let theirs = theirs.as_array().unwrap();

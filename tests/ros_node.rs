@@ -87,11 +87,15 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
         {"name": big, "position": vec![0.0; 100_000]},
         {"name": ["another_robots_joint"], "position": [1.0]},
     ]);
+    // check_states: good states, a NaN state and a state naming a joint the robot lacks.
+    let mut service_states: Vec<Value> = states[..5].iter().map(|(n, p)| json!({"name": n, "position": p, "stamp": 7})).collect();
+    service_states.insert(1, json!({"name": ["elbow_joint", "wrist_1_joint"], "position": [0.1, "NaN"], "stamp": 8}));
+    service_states.insert(3, json!({"name": ["elbow_joint", "no_such_joint"], "position": [0.1, 0.2], "stamp": 9}));
     let request = json!({
         "domain": domain,
         "bad": bad,
         "states": states.iter().enumerate().map(|(k, (n, p))| json!({"name": n, "position": p, "stamp": 1_000_000_000 + k})).collect::<Vec<_>>(),
-        "service_states": states[..5].iter().map(|(n, p)| json!({"name": n, "position": p})).collect::<Vec<_>>(),
+        "service_states": service_states,
         "timeout": 30,
         "node": "tc_test",
         "markers": true,
@@ -151,12 +155,21 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     for (k, (got, want)) in reports.iter().zip(&reference).enumerate() {
         same(got, want, &format!("topic, state {k}"));
         assert_eq!(got["stamp"].as_i64().unwrap(), 1_000_000_000 + k as i64, "stamped with the input's stamp");
+        assert_eq!(got["error"], "", "a checked state has no error");
         assert_eq!(got["frame_id"], "world");
     }
     let service = answer["service"].as_array().unwrap();
-    assert_eq!(service.len(), 5, "check_states answers every state");
-    for (k, (got, want)) in service.iter().zip(&reference).enumerate() {
+    assert_eq!(service.len(), 7, "check_states answers every state, bad ones in their slots");
+    // Fail closed: the bad slots say in collision, with the cause.
+    for (slot, cause) in [(1, "non-finite"), (3, "no_such_joint")] {
+        assert_eq!(service[slot]["in_collision"], true, "slot {slot}: {}", service[slot]);
+        assert!(service[slot]["error"].as_str().unwrap().contains(cause), "slot {slot}: {}", service[slot]);
+        assert!(service[slot]["contacts"].as_array().unwrap().is_empty());
+    }
+    let good: Vec<&Value> = service.iter().enumerate().filter(|(k, _)| *k != 1 && *k != 3).map(|(_, v)| v).collect();
+    for (k, (got, want)) in good.iter().zip(&reference).enumerate() {
         same(got, want, &format!("service, state {k}"));
+        assert_eq!(got["error"], "", "service, state {k}");
     }
 
     // SIGTERM: a clean shutdown.
@@ -193,13 +206,13 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     let mut lines = Vec::new();
     for k in 0..12 {
         let (names, pos) = state(k);
-        let mut q = vec![0.0; checker.robot.joints.len()];
+        let mut q = vec![0.0; checker.robot().joints.len()];
         for (n, p) in names.iter().zip(&pos) {
-            q[checker.robot.joint(n).unwrap()] = *p;
+            q[checker.robot().joint(n).unwrap()] = *p;
         }
-        let poses = checker.robot.forward_kinematics(&q, &nalgebra::Isometry3::identity());
+        let poses = checker.robot().forward_kinematics(&q, &nalgebra::Isometry3::identity()).unwrap();
         let (mut tfs, mut line) = (Vec::new(), Vec::new());
-        for t in &checker.targets {
+        for t in checker.targets() {
             let p = pose_from_isometry(&poses[t.link]);
             let r = [p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w];
             tfs.push(json!({"parent": "world", "child": format!("robot1/{}", t.name), "translation": p.translation.to_array(), "rotation": r}));

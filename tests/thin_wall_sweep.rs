@@ -45,9 +45,13 @@ fn a_link_behind_the_wall_is_caught_where_coal_misses_it() {
         lines.push('\n');
     }
     std::fs::write(dir.join("states.jsonl"), lines).unwrap();
+    // Only the hand is placed, so only the hand is checked (a transforms line must place every
+    // checked link).
+    std::fs::write(dir.join("hand_only.yaml"), "thickness_collision:\n  ros__parameters:\n    checked_links: [panda_hand]\n").unwrap();
 
     let out = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
         .args(["check", "--robot", panda.to_str().unwrap(), "--environment", dir.join("wall.urdf").to_str().unwrap()])
+        .args(["--params-file", dir.join("hand_only.yaml").to_str().unwrap()])
         .args(["--thickness", &T.to_string(), "--states", dir.join("states.jsonl").to_str().unwrap(), "--json"])
         .env("AMENT_PREFIX_PATH", erd.parent().unwrap().parent().unwrap())
         .output()

@@ -1,6 +1,6 @@
 //! Loading the robot and the environment and checking states against them.
 
-use super::joint_state::{resolve_positions, JointMemory, StateError};
+use super::joint_state::{resolve_positions, StateError};
 use super::state_report::{ReportContact, StateReport};
 use crate::collision::{CollideSettings, ConvexHull, Scene, Target, TargetShape};
 use crate::math::{pose_from_isometry, Pose, Vector};
@@ -83,18 +83,15 @@ pub struct BuildSummary {
     pub build_seconds: f64,
 }
 
-/// Robot, environment, targets and scene: everything needed to check a state.
+/// Robot, environment, targets and scene: everything needed to check a state. Built once from
+/// validated parameters and never changed after (a new robot or new parameters build a new one),
+/// so its parts stay consistent with each other.
 pub struct Checker {
-    /// The parameters in force.
-    pub params: Params,
-    /// The robot.
-    pub robot: RobotModel,
-    /// The checked links' targets.
-    pub targets: Vec<LinkTargets>,
-    /// The environment.
-    pub scene: Scene,
-    /// What was loaded.
-    pub summary: BuildSummary,
+    params: Params,
+    robot: RobotModel,
+    targets: Vec<LinkTargets>,
+    scene: Scene,
+    summary: BuildSummary,
     base: Isometry3<f64>,
     /// `allowed[target index][object index]`.
     allowed: Vec<Vec<bool>>,
@@ -143,6 +140,31 @@ fn base_isometry(p: &[f64]) -> Isometry3<f64> {
 }
 
 impl Checker {
+    /// The parameters in force.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The robot.
+    pub fn robot(&self) -> &RobotModel {
+        &self.robot
+    }
+
+    /// The checked links' targets, in model order.
+    pub fn targets(&self) -> &[LinkTargets] {
+        &self.targets
+    }
+
+    /// The environment.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// What was loaded.
+    pub fn summary(&self) -> &BuildSummary {
+        &self.summary
+    }
+
     /// Loads the robot and the environment named by the parameters (or the overrides), with
     /// the bundled example workcell as the default for both.
     pub fn from_params(params: Params, robot: Option<&Path>, environment: Option<&Path>) -> Result<Checker, CheckerError> {
@@ -177,6 +199,7 @@ impl Checker {
 
     /// A checker for `robot` against a scene built elsewhere (benchmarks, generated worlds).
     pub fn from_robot_and_scene(params: Params, robot: RobotModel, scene: Scene, robot_source: String) -> Result<Checker, CheckerError> {
+        params.validate()?;
         let empty = RobotModel::from_str("<robot name=\"empty\"><link name=\"world\"/></robot>", "empty", Path::new("."), &PackageResolver::default(), false)?;
         let mut checker = Self::from_models(params, robot, empty, robot_source, "generated scene".into())?;
         checker.summary.thin_surfaces = scene.objects().iter().filter(|o| o.area().is_some()).count();
@@ -186,13 +209,10 @@ impl Checker {
         Ok(checker)
     }
 
-    /// Checks many joint states at once, each on its own (`missing_joint: last` sees no earlier
-    /// state), on all cores with the `parallel` feature. Reports come back in input order.
-    pub fn check_joints_batch(&self, states: &[(Vec<String>, Vec<f64>)]) -> Vec<Result<StateReport, StateError>> {
-        let one = |(names, positions): &(Vec<String>, Vec<f64>)| {
-            let mut memory = JointMemory::new(&self.robot);
-            self.check_joints(names, positions, &mut memory, false).map(|(r, _)| r)
-        };
+    /// Checks many joint states at once, each on its own as [`Checker::check_joints`] does, on
+    /// all cores with the `parallel` feature. Reports come back in input order.
+    pub fn check_joints_batch<S: AsRef<[String]> + Sync, P: AsRef<[f64]> + Sync>(&self, states: &[(S, P)]) -> Vec<Result<StateReport, StateError>> {
+        let one = |(names, positions): &(S, P)| self.check_joints(names.as_ref(), positions.as_ref());
         #[cfg(feature = "parallel")]
         {
             use rayon::prelude::*;
@@ -206,12 +226,15 @@ impl Checker {
 
     /// Builds targets and scene from loaded models (the node's path for `robot_description`).
     pub fn from_models(params: Params, robot: RobotModel, env: RobotModel, robot_source: String, environment_source: String) -> Result<Checker, CheckerError> {
+        params.validate()?;
         let started = Instant::now();
         let mut cache = MeshCache::default();
         let mut summary = BuildSummary { robot_source, environment_source, robot_links: robot.links.len(), ..Default::default() };
 
         let mut scene = Scene::new();
-        let env_poses = env.forward_kinematics(&vec![0.0; env.joints.len()], &Isometry3::identity());
+        let env_poses = env.forward_kinematics(&vec![0.0; env.joints.len()], &Isometry3::identity()).map_err(|e| {
+            CheckerError::Model(ModelError::Structure { file: summary.environment_source.clone(), message: e.to_string() })
+        })?;
         for (li, link) in env.links.iter().enumerate() {
             for g in &link.geometry {
                 let pose = pose_from_isometry(&(env_poses[li] * g.origin));
@@ -277,50 +300,63 @@ impl Checker {
         Ok(Checker { params, robot, targets, scene, summary, base, allowed })
     }
 
-    /// Checks a joint state. Unknown names are returned for the caller to warn about (or, with
-    /// `strict`, are an error); positions outside limits are flagged in the report.
-    pub fn check_joints(&self, names: &[String], positions: &[f64], memory: &mut JointMemory, strict: bool) -> Result<(StateReport, Vec<String>), StateError> {
-        self.check_joints_with(names, positions, memory, strict, &CHECK_SETTINGS)
+    /// Checks a joint state given by name, on its own: an unknown name is an error, and a joint
+    /// it lacks is at 0 (an error under `missing_joint: reject`). Positions outside limits are
+    /// flagged in the report.
+    pub fn check_joints(&self, names: &[String], positions: &[f64]) -> Result<StateReport, StateError> {
+        let q = resolve_positions(&self.robot, names, positions, self.params.missing_joint)?;
+        self.check_positions(&q)
     }
 
     /// Which links collide, and nothing more: each link stops at its first colliding cell, and
-    /// its contact carries only link and object names (NaN depth, point and normal). The
+    /// its contact carries only link and object names (no depth, point or normal). The
     /// like-for-like counterpart of a boolean `collide` in FCL or coal.
-    pub fn check_joints_flags(&self, names: &[String], positions: &[f64], memory: &mut JointMemory) -> Result<StateReport, StateError> {
-        self.check_joints_with(names, positions, memory, false, &CollideSettings { flag_only: true, least_overlap: false, ..Default::default() }).map(|(r, _)| r)
+    pub fn check_joints_flags(&self, names: &[String], positions: &[f64]) -> Result<StateReport, StateError> {
+        let q = resolve_positions(&self.robot, names, positions, self.params.missing_joint)?;
+        self.check_positions_with(&q, &CollideSettings { flag_only: true, least_overlap: false, ..Default::default() })
     }
 
-    fn check_joints_with(&self, names: &[String], positions: &[f64], memory: &mut JointMemory, strict: bool, settings: &CollideSettings) -> Result<(StateReport, Vec<String>), StateError> {
+    /// Checks a position for every joint of the model (indexed like `robot().joints`).
+    pub fn check_positions(&self, q: &[f64]) -> Result<StateReport, StateError> {
+        self.check_positions_with(q, &CHECK_SETTINGS)
+    }
+
+    fn check_positions_with(&self, q: &[f64], settings: &CollideSettings) -> Result<StateReport, StateError> {
         let started = Instant::now();
-        let (q, unknown) = resolve_positions(&self.robot, names, positions, self.params.missing_joint, memory, strict)?;
-        let poses = self.robot.forward_kinematics(&q, &self.base);
+        let poses = self.robot.forward_kinematics(q, &self.base)?;
         let world: Vec<Option<Pose>> = poses.iter().map(|p| Some(pose_from_isometry(p))).collect();
         let mut report = self.check_link_poses(&world, settings);
         report.out_of_limits = self
             .robot
             .joints
             .iter()
-            .zip(&q)
+            .zip(q)
             .filter(|(j, v)| matches!(j.kind, JointKind::Revolute | JointKind::Prismatic) && (**v < j.limits[0] - 1e-12 || **v > j.limits[1] + 1e-12))
             .map(|(j, _)| j.name.clone())
             .collect();
         report.check_seconds = started.elapsed().as_secs_f64();
-        Ok((report, unknown))
+        Ok(report)
     }
 
-    /// Checks links at given world poses (`/tf` input); links not given are not checked.
-    pub fn check_transforms(&self, transforms: &[(String, Pose)]) -> Result<StateReport, StateError> {
+    /// Checks the links at given world poses (indexed like `robot().links`). Every checked link
+    /// needs a pose: a state with a checked link's pose unknown cannot be called free.
+    pub fn check_world_poses(&self, world: &[Option<Pose>]) -> Result<StateReport, StateError> {
         let started = Instant::now();
-        let mut world = vec![None; self.robot.links.len()];
-        for (name, pose) in transforms {
-            let li = self.robot.link(name).ok_or_else(|| StateError::UnknownLink(name.clone()))?;
-            let q = pose.rotation;
-            if !pose.translation.is_finite() || !q.is_finite() || (q.length() - 1.0).abs() > 1e-6 {
-                return Err(StateError::BadTransform(name.clone()));
-            }
-            world[li] = Some(Pose::from_parts(pose.translation, q.normalize()));
+        if world.len() != self.robot.links.len() {
+            return Err(StateError::Poses { expected: self.robot.links.len(), got: world.len() });
         }
-        let mut report = self.check_link_poses(&world, &CHECK_SETTINGS);
+        for t in &self.targets {
+            match world[t.link] {
+                None => return Err(StateError::NoPose(t.name.clone())),
+                Some(p) => {
+                    let q = p.rotation;
+                    if !p.translation.is_finite() || !q.is_finite() || (q.length() - 1.0).abs() > 1e-6 {
+                        return Err(StateError::BadTransform(t.name.clone()));
+                    }
+                }
+            }
+        }
+        let mut report = self.check_link_poses(world, &CHECK_SETTINGS);
         report.check_seconds = started.elapsed().as_secs_f64();
         Ok(report)
     }
@@ -353,7 +389,7 @@ impl Checker {
                     object_name: self.scene.objects()[c.object].name.clone(),
                     triangle: c.triangle,
                     depth: c.depth,
-                    position: c.position.to_array(),
+                    position: c.position.map(|p| p.to_array()),
                     normal: c.normal.to_array(),
                 });
             }

@@ -6,9 +6,7 @@
 mod checker_build;
 mod joint_state;
 mod state_report;
-mod tf_tree;
 
 pub use self::checker_build::{BuildSummary, Checker, CheckerError, LinkTargets};
-pub use self::joint_state::{JointMemory, StateError};
+pub use self::joint_state::StateError;
 pub use self::state_report::{ReportContact, StateReport};
-pub use self::tf_tree::TfTree;

@@ -13,13 +13,16 @@ pub struct ReportContact {
     pub triangle: u32,
     /// How far the link reaches past the surface along `normal` (metres).
     pub depth: f64,
-    /// A point within 1e-6 m of both shapes (world frame).
-    pub position: [f64; 3],
+    /// A point within 1e-6 m of both shapes (world frame); `None` only from a flags-only check.
+    pub position: Option<[f64; 3]>,
     /// Push-out direction (world frame).
     pub normal: [f64; 3],
 }
 
 /// The result for one state, as in `thickness_collision_msgs/CollisionReport` (without header).
+///
+/// Fail closed: a state that could not be checked is reported with `in_collision` set and the
+/// cause in `error` ([`StateReport::failed`]), never as free.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct StateReport {
     /// Whether any checked link collides.
@@ -29,7 +32,17 @@ pub struct StateReport {
     /// Joints whose position lies outside their limits.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub out_of_limits: Vec<String>,
+    /// Why the state could not be checked; empty when it was.
+    #[serde(default)]
+    pub error: String,
     /// Seconds spent checking (not part of `check --json`, which must be deterministic).
     #[serde(skip)]
     pub check_seconds: f64,
+}
+
+impl StateReport {
+    /// The report of a state that could not be checked: in collision, with the cause.
+    pub fn failed(error: impl Into<String>) -> StateReport {
+        StateReport { in_collision: true, error: error.into(), ..Default::default() }
+    }
 }

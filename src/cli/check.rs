@@ -1,19 +1,30 @@
 //! `check`: robot states from the command line or a JSON-lines file, reports on standard output.
+//! A states file goes through the node's pipeline line by line, as a recorded stream would.
 
 use crate::ModelArgs;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::Deserialize;
 use std::io::{BufRead, Write};
 use std::path::Path;
-use thickness_collision::checker::{Checker, JointMemory, StateReport};
-use thickness_collision::math::{Pose, Rotation, Vector};
+use thickness_collision::checker::StateReport;
+use thickness_collision::msgs::{Header, JointState, Quaternion, TfMessage, Time, Transform, TransformStamped, Vector3};
+use thickness_collision::pipeline::{CheckedState, Pipeline};
 
 /// One line of a states file.
 #[derive(Deserialize)]
 #[serde(untagged, deny_unknown_fields)]
 enum StateLine {
-    Joints { name: Vec<String>, position: Vec<f64> },
-    Transforms { transforms: Vec<LinkTransform> },
+    Joints {
+        name: Vec<String>,
+        position: Vec<f64>,
+        #[serde(default)]
+        stamp: i64,
+    },
+    Transforms {
+        transforms: Vec<LinkTransform>,
+        #[serde(default)]
+        stamp: i64,
+    },
 }
 
 #[derive(Deserialize)]
@@ -23,6 +34,10 @@ struct LinkTransform {
     translation: [f64; 3],
     rotation: [f64; 4],
 }
+
+/// Longest states-file line read (a state of a few hundred joints is a few kB): a file without
+/// newlines must not be read into memory whole.
+const MAX_LINE: u64 = 1 << 20;
 
 fn parse_joints(spec: &str) -> Result<(Vec<String>, Vec<f64>)> {
     let mut names = Vec::new();
@@ -44,64 +59,94 @@ pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json
         print!("{}", super::load::params(args)?.to_yaml());
         return Ok(());
     }
-    let checker = super::load::checker(args)?;
-    let s = &checker.summary;
+    let mut pipeline = super::load::pipeline(args)?;
+    let s = pipeline.checker().summary();
     eprintln!(
         "loaded {} ({} links, {} checked) and {} ({} thin surfaces, {} cells, {} solids) in {:.1} ms",
         s.robot_source, s.robot_links, s.checked_links, s.environment_source, s.thin_surfaces, s.cells, s.solids, s.build_seconds * 1e3
     );
-    let mut memory = JointMemory::new(&checker.robot);
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     if let Some(spec) = joints {
         let (names, values) = parse_joints(spec)?;
-        let (report, _) = checker.check_joints(&names, &values, &mut memory, true).context("--joints")?;
-        emit(&mut out, 1, &report, json)?;
+        let report = pipeline.checker().check_joints(&names, &values).context("--joints")?;
+        emit(&mut out, 1, &CheckedState { stamp: Time::default(), report }, json)?;
     } else if let Some(path) = states {
         let file = std::fs::File::open(path).with_context(|| format!("cannot read states file {}", path.display()))?;
-        for (i, line) in std::io::BufReader::new(file).lines().enumerate() {
-            let n = i + 1;
-            let line = line.with_context(|| format!("{}: line {n}", path.display()))?;
+        let mut reader = std::io::BufReader::new(file);
+        let mut first_bad: Option<(usize, String)> = None;
+        let mut line = String::new();
+        for n in 1.. {
+            line.clear();
+            let read = std::io::Read::take(&mut reader, MAX_LINE + 1).read_line(&mut line).with_context(|| format!("{}: line {n}", path.display()))?;
+            if read == 0 {
+                break;
+            }
+            if read as u64 > MAX_LINE {
+                bail!("{}: line {n} is longer than {MAX_LINE} bytes", path.display());
+            }
             if line.trim().is_empty() {
                 continue;
             }
-            let report = check_line(&checker, &line, &mut memory).with_context(|| format!("{}: line {n}", path.display()))?;
-            emit(&mut out, n, &report, json)?;
+            let state: StateLine = serde_json::from_str(&line)
+                .map_err(|e| anyhow!("{}: line {n}: not a state ({e}); expected {{\"name\": [...], \"position\": [...]}} or {{\"transforms\": [...]}}", path.display()))?;
+            let checked = check_line(&mut pipeline, state);
+            for w in pipeline.take_warnings() {
+                eprintln!("thickness_collision: warning: {w}");
+            }
+            if !checked.report.error.is_empty() && first_bad.is_none() {
+                first_bad = Some((n, checked.report.error.clone()));
+            }
+            emit(&mut out, n, &checked, json)?;
+        }
+        out.flush()?;
+        if let Some((n, error)) = first_bad {
+            bail!("{}: line {n}: the state cannot be checked: {error} (reported in collision; later lines were checked)", path.display());
         }
     }
     out.flush()?;
     Ok(())
 }
 
-fn check_line(checker: &Checker, line: &str, memory: &mut JointMemory) -> Result<StateReport> {
-    let state: StateLine = serde_json::from_str(line).map_err(|e| anyhow!("not a state ({e}); expected {{\"name\": [...], \"position\": [...]}} or {{\"transforms\": [...]}}"))?;
-    match state {
-        StateLine::Joints { name, position } => {
-            let (report, unknown) = checker.check_joints(&name, &position, memory, false)?;
-            for u in unknown {
-                if memory.first_unknown(&u) {
-                    eprintln!("thickness_collision: warning: '{u}' is not a joint of the robot model; ignored (warned once)");
-                }
-            }
-            Ok(report)
+/// A line through the pipeline; a state it cannot check fails closed in its place.
+fn check_line(pipeline: &mut Pipeline, state: StateLine) -> CheckedState {
+    let (stamp, result) = match state {
+        StateLine::Joints { name, position, stamp } => {
+            let stamp = Time::from_nanos(stamp);
+            let msg = JointState { header: Header { stamp, frame_id: String::new() }, name, position, ..Default::default() };
+            (stamp, pipeline.joint_state(&msg))
         }
-        StateLine::Transforms { transforms } => {
-            let poses: Vec<(String, Pose)> = transforms
+        StateLine::Transforms { transforms, stamp } => {
+            let stamp = Time::from_nanos(stamp);
+            let (world, prefix) = (pipeline.params().world_frame.clone(), pipeline.params().frame_prefix.clone());
+            let transforms = transforms
                 .into_iter()
                 .map(|t| {
-                    let [x, y, z, w] = t.rotation;
-                    (t.link, Pose::from_parts(Vector::from_array(t.translation), Rotation::from_xyzw(x, y, z, w)))
+                    let ([x, y, z], [qx, qy, qz, qw]) = (t.translation, t.rotation);
+                    TransformStamped {
+                        header: Header { stamp, frame_id: world.clone() },
+                        child_frame_id: format!("{prefix}{}", t.link),
+                        transform: Transform { translation: Vector3 { x, y, z }, rotation: Quaternion { x: qx, y: qy, z: qz, w: qw } },
+                    }
                 })
                 .collect();
-            Ok(checker.check_transforms(&poses)?)
+            (stamp, pipeline.tf(&TfMessage { transforms }))
         }
+    };
+    match result {
+        Ok(state) => pipeline.check(&state),
+        Err(skip) => CheckedState { stamp, report: StateReport::failed(skip.message) },
     }
 }
 
-fn emit(out: &mut impl Write, n: usize, report: &StateReport, json: bool) -> Result<()> {
+fn emit(out: &mut impl Write, n: usize, checked: &CheckedState, json: bool) -> Result<()> {
     if json {
-        serde_json::to_writer(&mut *out, report)?;
-        writeln!(out)?;
+        writeln!(out, "{}", checked.json())?;
+        return Ok(());
+    }
+    let report = &checked.report;
+    if !report.error.is_empty() {
+        writeln!(out, "state {n}: NOT CHECKED, reported in collision: {}", report.error)?;
         return Ok(());
     }
     let limits = if report.out_of_limits.is_empty() { String::new() } else { format!(" (outside limits: {})", report.out_of_limits.join(", ")) };
@@ -112,11 +157,8 @@ fn emit(out: &mut impl Write, n: usize, report: &StateReport, json: bool) -> Res
     writeln!(out, "state {n}: IN COLLISION{limits}")?;
     for c in &report.contacts {
         let tri = if c.triangle == u32::MAX { "solid".to_string() } else { format!("triangle {}", c.triangle) };
-        writeln!(
-            out,
-            "  {} x {} ({tri}): depth {:.4} m, normal [{:.3}, {:.3}, {:.3}], point [{:.4}, {:.4}, {:.4}]",
-            c.link_name, c.object_name, c.depth, c.normal[0], c.normal[1], c.normal[2], c.position[0], c.position[1], c.position[2]
-        )?;
+        let point = c.position.map_or("none".into(), |p| format!("[{:.4}, {:.4}, {:.4}]", p[0], p[1], p[2]));
+        writeln!(out, "  {} x {} ({tri}): depth {:.4} m, normal [{:.3}, {:.3}, {:.3}], point {point}", c.link_name, c.object_name, c.depth, c.normal[0], c.normal[1], c.normal[2])?;
     }
     Ok(())
 }

@@ -2,7 +2,7 @@
 
 use crate::ModelArgs;
 use anyhow::{bail, Result};
-use thickness_collision::checker::Checker;
+use thickness_collision::pipeline::Pipeline;
 use thickness_collision::model::Params;
 
 /// The parameters file (or the defaults) with the command line's overrides applied.
@@ -19,15 +19,15 @@ pub fn params(args: &ModelArgs) -> Result<Params> {
         params.thin_surfaces.thickness.iter_mut().for_each(|x| *x = t);
     }
     if let Some(side) = args.side {
-        params.default_side = side.as_str().into();
+        params.default_side = side;
         let n = params.thin_surfaces.patterns.len();
-        params.thin_surfaces.side = vec![side.as_str().into(); n];
+        params.thin_surfaces.side = vec![side; n];
     }
     params.validate()?;
     Ok(params)
 }
 
-/// Loads the robot and the environment.
-pub fn checker(args: &ModelArgs) -> Result<Checker> {
-    Ok(Checker::from_params(params(args)?, args.robot.as_deref(), args.environment.as_deref())?)
+/// Loads the robot and the environment into the pipeline every front door feeds.
+pub fn pipeline(args: &ModelArgs) -> Result<Pipeline> {
+    Ok(Pipeline::new(params(args)?, args.robot.as_deref(), args.environment.as_deref())?)
 }

@@ -27,7 +27,7 @@ mod target;
 
 pub use self::cell_contact::{collide_target_cell, CellHit};
 pub use self::cell_tree::CellTree;
-pub use self::report::{CollideSettings, Contact, TargetReport};
+pub use self::report::{CollideSettings, Contact, LeastOverlap, TargetReport};
 pub use self::scene::{ObjectBody, Scene, SceneObject};
 pub use self::target::{ConvexHull, Target, TargetShape};
 

@@ -9,9 +9,9 @@ pub struct CollideSettings {
     pub all_contacts: bool,
     /// Only ask whether the target collides: stop at the first colliding cell, no contact point.
     pub flag_only: bool,
-    /// Fill [`Contact::overlap`] and [`Contact::axis`] (the least overlap, from the full SAT of
-    /// the reported pair). Without it a pair that cheaper tests already proved colliding skips
-    /// that SAT (~10 µs on a 300-face link hull), and they are NaN.
+    /// Fill [`Contact::least`] (the least overlap, from the full SAT of the reported pair).
+    /// Without it a pair that cheaper tests already proved colliding skips that SAT (~10 µs on a
+    /// 300-face link hull), and it is `None`.
     pub least_overlap: bool,
 }
 
@@ -32,12 +32,20 @@ pub struct Contact {
     pub depth: Real,
     /// Push-out direction (unit).
     pub normal: Vector,
-    /// A point within 1e-6 m of both shapes (NaN when `flag_only`).
-    pub position: Vector,
-    /// Least overlap of the pair (metres): the minimal translation. Without
-    /// [`CollideSettings::least_overlap`] it is NaN where cheaper tests decided the pair.
+    /// A point within 1e-6 m of both shapes (`None` when `flag_only`, or where the clipped
+    /// contact region is degenerate).
+    pub position: Option<Vector>,
+    /// The least overlap of the pair: the minimal translation. Without
+    /// [`CollideSettings::least_overlap`] it is `None` where cheaper tests decided the pair.
+    pub least: Option<LeastOverlap>,
+}
+
+/// The minimal translation that separates a colliding pair.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LeastOverlap {
+    /// How far (metres).
     pub overlap: Real,
-    /// Unit direction in which the target moves by `overlap` to separate (NaN with `overlap`).
+    /// Unit direction in which the target moves by `overlap` to separate.
     pub axis: Vector,
 }
 

@@ -1,7 +1,7 @@
 //! The environment: objects with their cells in a BVH, and the queries against them.
 
 use super::cell_contact::{normal_axis_deeper, quick_decide, LocalPair, NormalAxis, RecentAxes};
-use super::report::{CollideSettings, Contact, TargetReport};
+use super::report::{CollideSettings, Contact, LeastOverlap, TargetReport};
 use super::target::{Target, TargetShape, MANY};
 use crate::math::{Aabb, Pose, Real, Vector};
 use crate::thickness::{ThicknessArea, ThicknessCell};
@@ -115,7 +115,6 @@ impl Scene {
     /// Checks one target against the objects for which `check(object index)` is true.
     pub fn collide_filtered(&self, target: &Target, settings: &CollideSettings, check: impl Fn(usize) -> bool) -> TargetReport {
         let mut report = TargetReport::default();
-        let nan = Vector::splat(Real::NAN);
         let rot = target.pose.rotation;
         let mut deepest: Option<Contact> = None;
         let target_aabb = target.aabb_in(&target.pose);
@@ -180,15 +179,15 @@ impl Scene {
                             continue;
                         }
                         hit_object = true;
-                        let (overlap, axis) = sat.map_or((Real::NAN, nan), |s| (s.overlap, rot * s.axis));
-                        let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: nan, overlap, axis };
+                        let least = sat.map(|s| LeastOverlap { overlap: s.overlap, axis: rot * s.axis });
+                        let mut contact = Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position: None, least };
                         if settings.flag_only {
                             // A yes/no question: the first cell that collides answers it.
                             report.objects.push(oi);
                             report.contacts.push(contact);
                             return report;
                         }
-                        contact.position = LocalPair::new(target, cell, &pos12).point(push).map_or(nan, |p| target.pose * p);
+                        contact.position = LocalPair::new(target, cell, &pos12).point(push).map(|p| target.pose * p);
                         report.contacts.push(contact);
                     }
                 }
@@ -196,9 +195,9 @@ impl Scene {
                 hit_object = true;
                 if deepest.as_ref().map_or(true, |d| depth > d.depth) {
                     let cell = &area.cells[leaf as usize];
-                    let position = LocalPair::new(target, cell, &pos12).point(push).map_or(nan, |p| target.pose * p);
-                    let (overlap, axis) = sat.map_or((Real::NAN, nan), |s| (s.overlap, rot * s.axis));
-                    deepest = Some(Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position, overlap, axis });
+                    let position = LocalPair::new(target, cell, &pos12).point(push).map(|p| target.pose * p);
+                    let least = sat.map(|s| LeastOverlap { overlap: s.overlap, axis: rot * s.axis });
+                    deepest = Some(Contact { object: oi, triangle: cell.triangle, depth, normal: rot * push, position, least });
                 }
             }
             if hit_object {
@@ -230,7 +229,7 @@ fn collide_solid(target: &Target, object: usize, object_pose: &Pose, shape: &Tar
         return None;
     }
     let normal = -c.normal1;
-    Some(Contact { object, triangle: u32::MAX, depth: -c.dist, normal, position: (c.point1 + c.point2) * 0.5, overlap: -c.dist, axis: normal })
+    Some(Contact { object, triangle: u32::MAX, depth: -c.dist, normal, position: Some((c.point1 + c.point2) * 0.5), least: Some(LeastOverlap { overlap: -c.dist, axis: normal }) })
 }
 
 /// How much deeper than the deepest contact found a subtree's bound must be to be searched: the

@@ -1,6 +1,7 @@
 //! Files turned into the plain data the core takes: URDF robots and environments, mesh files,
 //! `package://` URIs, the parameters file, and forward kinematics.
 
+#[cfg(feature = "testing")]
 pub mod example_workcell;
 pub mod mesh_file;
 mod package;
@@ -8,5 +9,5 @@ mod params;
 mod robot;
 
 pub use self::package::{PackageError, PackageResolver};
-pub use self::params::{bundled_config_dir, glob_match, parse_side, MissingJoint, Padding, Params, ParamsError, ThinSurfaces};
-pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, RobotModel};
+pub use self::params::{bundled_config_dir, glob_match, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};
+pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, PositionsError, RobotModel};

@@ -13,13 +13,52 @@ use std::path::{Path, PathBuf};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum MissingJoint {
-    /// Use 0.
-    #[default]
+    /// Each message alone: a joint it does not name is at 0.
     Zero,
-    /// Use the last value seen for it (0 before any).
+    /// Partial messages are merged, as robot_state_publisher merges several publishers: a joint a
+    /// message does not name keeps its last received value (0 before any).
+    #[default]
     Last,
-    /// Reject the state.
+    /// Merged as `last`, but a state is refused while some actuated joint has never been received
+    /// (a service request's state must name every actuated joint).
     Reject,
+}
+
+/// Where the node and replay take robot states from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum PoseSource {
+    /// `sensor_msgs/JointState` through forward kinematics.
+    #[default]
+    #[serde(rename = "joint_states")]
+    JointStates,
+    /// `tf2_msgs/TFMessage` on `/tf` and `/tf_static`: link poses composed up to `world_frame`.
+    #[serde(rename = "tf")]
+    Tf,
+}
+
+impl std::str::FromStr for PoseSource {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<PoseSource, String> {
+        match s {
+            "joint_states" => Ok(PoseSource::JointStates),
+            "tf" => Ok(PoseSource::Tf),
+            _ => Err(format!("'{s}' is not a pose source (joint_states or tf)")),
+        }
+    }
+}
+
+/// How requests and replies of the node's services are matched on DDS.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ServiceMapping {
+    /// rmw_cyclonedds's mapping.
+    #[default]
+    Cyclone,
+    /// rmw_fastrtps's and rmw_connextdds's mapping (sample identity beside each request).
+    Enhanced,
+    /// The DDS-RPC basic mapping.
+    Basic,
 }
 
 /// Per-pattern thickness and side of thin surfaces (parallel arrays).
@@ -30,8 +69,8 @@ pub struct ThinSurfaces {
     pub patterns: Vec<String>,
     /// Thickness for each pattern (metres).
     pub thickness: Vec<f64>,
-    /// Side for each pattern (`back`, `front`, `both`); may be empty (then `default_side`).
-    pub side: Vec<String>,
+    /// Side for each pattern; may be empty (then `default_side`).
+    pub side: Vec<Side>,
 }
 
 /// Per-link padding of robot links (parallel arrays).
@@ -59,7 +98,7 @@ pub struct Params {
     /// Thickness of thin surfaces no pattern matches (metres).
     pub default_thickness: f64,
     /// Side of thin surfaces no pattern matches.
-    pub default_side: String,
+    pub default_side: Side,
     /// `package://` resolution: `["pkg=/path/to/pkg", ...]`, searched first.
     pub package_map: Vec<String>,
     /// Per-pattern thickness and side.
@@ -70,14 +109,14 @@ pub struct Params {
     pub padding: Padding,
     /// `["robot_link:environment_link", ...]` pairs never reported (globs allowed).
     pub allowed_collisions: Vec<String>,
-    /// `zero`, `last` or `reject`.
+    /// What a state that lacks a joint means.
     pub missing_joint: MissingJoint,
     /// Robot links (globs) that are checked; default all.
     pub checked_links: Vec<String>,
     /// Use visual geometry for links that have no collision geometry.
     pub use_visual_when_no_collision: bool,
-    /// Where the node takes robot states from: `joint_states` (forward kinematics) or `tf`.
-    pub pose_source: String,
+    /// Where the node and replay take robot states from.
+    pub pose_source: PoseSource,
     /// Prefix of the robot's frames on `/tf` (e.g. `robot1/` when several robots share it).
     pub frame_prefix: String,
     /// At most this many cells are drawn on `collision_markers/cells`.
@@ -86,9 +125,8 @@ pub struct Params {
     pub marker_rate: f64,
     /// Stamp the node's own messages (markers, diagnostics) with `/clock` time.
     pub use_sim_time: bool,
-    /// Request/reply mapping of `check_states`: `cyclone` (rmw_cyclonedds), `enhanced` (Fast DDS,
-    /// Connext) or `basic`.
-    pub service_mapping: String,
+    /// Request/reply mapping of the node's services.
+    pub service_mapping: ServiceMapping,
 }
 
 impl Default for Params {
@@ -99,24 +137,28 @@ impl Default for Params {
             world_frame: "world".into(),
             robot_base_pose: vec![0.0; 6],
             default_thickness: 0.02,
-            default_side: "back".into(),
+            default_side: Side::Back,
             package_map: Vec::new(),
             thin_surfaces: ThinSurfaces::default(),
             solid_hull: Vec::new(),
             padding: Padding::default(),
             allowed_collisions: Vec::new(),
-            missing_joint: MissingJoint::Zero,
+            missing_joint: MissingJoint::Last,
             checked_links: vec!["*".into()],
             use_visual_when_no_collision: false,
-            pose_source: "joint_states".into(),
+            pose_source: PoseSource::JointStates,
             frame_prefix: String::new(),
             marker_max_cells: 20_000,
             marker_rate: 10.0,
             use_sim_time: false,
-            service_mapping: "cyclone".into(),
+            service_mapping: ServiceMapping::Cyclone,
         }
     }
 }
+
+/// Marker rates outside this range (Hz) are refused: below it a period overflows a `Duration`
+/// long before anyone would wait for it, above it the markers would cost more than the checks.
+const MARKER_RATE_RANGE: (f64, f64) = (1e-3, 1e4);
 
 /// A parameters file or value that cannot be used.
 #[derive(Debug, thiserror::Error)]
@@ -158,12 +200,12 @@ impl Params {
 
     /// Parses the node's section of a ROS 2 parameters YAML (`path` names it in errors).
     pub fn from_yaml(text: &str, path: &Path) -> Result<Params, ParamsError> {
-        let doc: serde_yaml::Value = serde_yaml::from_str(text).map_err(|e| ParamsError::Yaml(path.to_owned(), e.to_string()))?;
+        let doc: serde_yaml_ng::Value = serde_yaml_ng::from_str(text).map_err(|e| ParamsError::Yaml(path.to_owned(), e.to_string()))?;
         let section = ["thickness_collision", "/thickness_collision", "/**"]
             .iter()
             .find_map(|k| doc.get(k).and_then(|s| s.get("ros__parameters")))
             .ok_or_else(|| ParamsError::NoSection(path.to_owned()))?;
-        let params: Params = serde_yaml::from_value(section.clone()).map_err(|e| ParamsError::Yaml(path.to_owned(), e.to_string()))?;
+        let params: Params = serde_yaml_ng::from_value(section.clone()).map_err(|e| ParamsError::Yaml(path.to_owned(), e.to_string()))?;
         params.validate()?;
         Ok(params)
     }
@@ -177,9 +219,6 @@ impl Params {
         if !(self.default_thickness > 0.0 && self.default_thickness.is_finite()) {
             return bad("default_thickness", format!("must be a positive number of metres, got {}", self.default_thickness));
         }
-        if parse_side(&self.default_side).is_none() {
-            return bad("default_side", format!("must be back, front or both, got '{}'", self.default_side));
-        }
         let ts = &self.thin_surfaces;
         if ts.thickness.len() != ts.patterns.len() {
             return bad("thin_surfaces.thickness", format!("has {} values for {} patterns", ts.thickness.len(), ts.patterns.len()));
@@ -190,29 +229,24 @@ impl Params {
         if let Some(t) = ts.thickness.iter().find(|t| !(**t > 0.0 && t.is_finite())) {
             return bad("thin_surfaces.thickness", format!("must be positive, got {t}"));
         }
-        if let Some(s) = ts.side.iter().find(|s| parse_side(s).is_none()) {
-            return bad("thin_surfaces.side", format!("must be back, front or both, got '{s}'"));
-        }
         if self.padding.values.len() != self.padding.links.len() {
             return bad("padding.values", format!("has {} values for {} link patterns", self.padding.values.len(), self.padding.links.len()));
         }
         if let Some(p) = self.padding.values.iter().find(|p| !(**p >= 0.0 && p.is_finite())) {
             return bad("padding.values", format!("must be >= 0, got {p}"));
         }
-        if let Some(p) = self.allowed_collisions.iter().find(|p| p.split(':').count() != 2) {
+        if let Some(p) = self.allowed_collisions.iter().find(|p| p.split(':').count() != 2 || p.split(':').any(str::is_empty)) {
             return bad("allowed_collisions", format!("'{p}' is not of the form robot_link:environment_link"));
         }
         if self.marker_max_cells < 0 {
             return bad("marker_max_cells", format!("must be >= 0, got {}", self.marker_max_cells));
         }
-        if !(self.marker_rate > 0.0 && self.marker_rate.is_finite()) {
-            return bad("marker_rate", format!("must be a positive rate in Hz, got {}", self.marker_rate));
+        let (lo, hi) = MARKER_RATE_RANGE;
+        if !(self.marker_rate >= lo && self.marker_rate <= hi) {
+            return bad("marker_rate", format!("must be a rate from {lo} to {hi} Hz, got {}", self.marker_rate));
         }
-        if !matches!(self.service_mapping.as_str(), "cyclone" | "enhanced" | "basic") {
-            return bad("service_mapping", format!("must be cyclone, enhanced or basic, got '{}'", self.service_mapping));
-        }
-        if !matches!(self.pose_source.as_str(), "joint_states" | "tf") {
-            return bad("pose_source", format!("must be joint_states or tf, got '{}'", self.pose_source));
+        if self.world_frame.trim_start_matches('/').is_empty() {
+            return bad("world_frame", format!("must name a frame, got '{}'", self.world_frame));
         }
         if let Some(p) = self.package_map.iter().find(|p| !p.contains('=')) {
             return bad("package_map", format!("'{p}' is not of the form package=/path"));
@@ -222,17 +256,17 @@ impl Params {
 
     /// Thickness and side of the thin surface on environment link `link`.
     pub fn surface_settings(&self, link: &str) -> (f64, Side) {
-        let default_side = parse_side(&self.default_side).unwrap_or_default();
         let ts = &self.thin_surfaces;
+        // validate() keeps the arrays parallel; a pattern without its thickness falls back.
         match ts.patterns.iter().position(|p| glob_match(p, link)) {
-            Some(i) => (ts.thickness[i], ts.side.get(i).and_then(|s| parse_side(s)).unwrap_or(default_side)),
-            None => (self.default_thickness, default_side),
+            Some(i) => (ts.thickness.get(i).copied().unwrap_or(self.default_thickness), ts.side.get(i).copied().unwrap_or(self.default_side)),
+            None => (self.default_thickness, self.default_side),
         }
     }
 
     /// Padding of robot link `link` (metres).
     pub fn padding_of(&self, link: &str) -> f64 {
-        self.padding.links.iter().position(|p| glob_match(p, link)).map_or(0.0, |i| self.padding.values[i])
+        self.padding.links.iter().position(|p| glob_match(p, link)).and_then(|i| self.padding.values.get(i).copied()).unwrap_or(0.0)
     }
 
     /// Whether a collision between robot link `link` and environment link `object` is allowed.
@@ -253,7 +287,82 @@ impl Params {
         self.solid_hull.iter().any(|p| glob_match(p, link))
     }
 
-    /// The parameters as a ROS 2 parameters YAML (for `--show-default-params`).
+    /// Every parameter as a dotted name and its value (`thin_surfaces.patterns`, ...): what a ROS 2
+    /// node declares. Enumerations are strings, as in the parameters file.
+    pub fn flat(&self) -> Vec<(String, serde_json::Value)> {
+        fn walk(prefix: &str, v: serde_json::Value, out: &mut Vec<(String, serde_json::Value)>) {
+            match v {
+                serde_json::Value::Object(map) => {
+                    for (k, v) in map {
+                        let name = if prefix.is_empty() { k } else { format!("{prefix}.{k}") };
+                        walk(&name, v, out);
+                    }
+                }
+                v => out.push((prefix.to_owned(), v)),
+            }
+        }
+        let mut out = Vec::new();
+        // Params holds only strings, numbers, booleans, arrays and nested structs: it always
+        // serialises; an empty list is what a failure could give, never a panic.
+        if let Ok(v) = serde_json::to_value(self) {
+            walk("", v, &mut out);
+        }
+        out
+    }
+
+    /// The element of every list parameter, by dotted name: what an empty list would hold.
+    pub fn array_kinds() -> Vec<(String, serde_json::Value)> {
+        let sample = Params {
+            robot_base_pose: vec![0.0],
+            package_map: vec![String::new()],
+            thin_surfaces: ThinSurfaces { patterns: vec![String::new()], thickness: vec![0.0], side: vec![Side::Back] },
+            solid_hull: vec![String::new()],
+            padding: Padding { links: vec![String::new()], values: vec![0.0] },
+            allowed_collisions: vec![String::new()],
+            checked_links: vec![String::new()],
+            ..Params::default()
+        };
+        sample.flat().into_iter().filter_map(|(n, v)| match v {
+            serde_json::Value::Array(mut a) => a.pop().map(|e| (n, e)),
+            _ => None,
+        }).collect()
+    }
+
+    /// These parameters with `name` (dotted, as in [`Params::flat`]) set to `value`, validated.
+    pub fn with_value(&self, name: &str, value: serde_json::Value) -> Result<Params, ParamsError> {
+        let params = self.with_unchecked(name, value)?;
+        params.validate()?;
+        Ok(params)
+    }
+
+    fn with_unchecked(&self, name: &str, value: serde_json::Value) -> Result<Params, ParamsError> {
+        let invalid = |message: String| ParamsError::Invalid { name: name.to_owned(), message };
+        let mut doc = serde_json::to_value(self).map_err(|e| invalid(e.to_string()))?;
+        let mut at = &mut doc;
+        for part in name.split('.') {
+            at = at.as_object_mut().and_then(|m| m.get_mut(part)).ok_or_else(|| invalid("no such parameter".into()))?;
+        }
+        if at.is_object() {
+            return Err(invalid("is a group; set its members".into()));
+        }
+        *at = value;
+        serde_json::from_value(doc).map_err(|e| invalid(e.to_string()))
+    }
+
+    /// These parameters with `-p name:=value` overrides applied (values are YAML, as `ros2 run`
+    /// reads them), then validated together: parallel arrays may change one by one.
+    pub fn with_overrides(&self, overrides: &[(String, String)]) -> Result<Params, ParamsError> {
+        let mut params = self.clone();
+        for (name, text) in overrides {
+            let value: serde_json::Value = serde_yaml_ng::from_str(text)
+                .map_err(|e| ParamsError::Invalid { name: name.clone(), message: format!("'{text}' is not a YAML value: {e}") })?;
+            params = params.with_unchecked(name, value)?;
+        }
+        params.validate()?;
+        Ok(params)
+    }
+
+    /// The parameters as a ROS 2 parameters YAML (for `check --show-params`).
     pub fn to_yaml(&self) -> String {
         #[derive(Serialize)]
         struct Section<'a> {
@@ -264,17 +373,7 @@ impl Params {
         struct File<'a> {
             thickness_collision: Section<'a>,
         }
-        serde_yaml::to_string(&File { thickness_collision: Section { params: self } }).unwrap_or_default()
-    }
-}
-
-/// `back`, `front` or `both`.
-pub fn parse_side(s: &str) -> Option<Side> {
-    match s {
-        "back" => Some(Side::Back),
-        "front" => Some(Side::Front),
-        "both" => Some(Side::Both),
-        _ => None,
+        serde_yaml_ng::to_string(&File { thickness_collision: Section { params: self } }).unwrap_or_default()
     }
 }
 
@@ -319,6 +418,40 @@ mod tests {
     fn unknown_key_is_named() {
         let e = Params::from_yaml("thickness_collision:\n  ros__parameters:\n    default_thicknes: 0.1\n", Path::new("p.yaml")).unwrap_err();
         assert!(e.to_string().contains("default_thicknes"), "{e}");
+    }
+
+    #[test]
+    fn overrides_are_typed_and_validated() {
+        let p = Params::default();
+        let q = p.with_overrides(&[("default_thickness".into(), "0.05".into()), ("thin_surfaces.patterns".into(), "[a]".into()), ("thin_surfaces.thickness".into(), "[1]".into())]).unwrap();
+        assert_eq!(q.default_thickness, 0.05);
+        assert_eq!(q.thin_surfaces.thickness, vec![1.0]);
+        assert_eq!(q.surface_settings("a"), (1.0, Side::Back));
+        let q = p.with_overrides(&[("pose_source".into(), "tf".into()), ("missing_joint".into(), "reject".into())]).unwrap();
+        assert_eq!((q.pose_source, q.missing_joint), (PoseSource::Tf, MissingJoint::Reject));
+        for (k, v, says) in [
+            ("pose_source", "tcp", "pose_source"),
+            ("default_side", "left", "default_side"),
+            ("marker_rate", "1e-300", "marker_rate"),
+            ("nonexistent", "1", "nonexistent"),
+            ("thin_surfaces", "1", "group"),
+            ("default_thickness", "-1", "default_thickness"),
+        ] {
+            let e = p.with_overrides(&[(k.into(), v.into())]).unwrap_err().to_string();
+            assert!(e.contains(says), "{k}:={v}: {e}");
+        }
+    }
+
+    #[test]
+    fn flat_names_every_parameter_once() {
+        let flat = Params::default().flat();
+        let names: Vec<&str> = flat.iter().map(|(n, _)| n.as_str()).collect();
+        for n in ["default_thickness", "thin_surfaces.patterns", "padding.values", "pose_source", "service_mapping"] {
+            assert_eq!(names.iter().filter(|x| **x == n).count(), 1, "{n} in {names:?}");
+        }
+        for (n, v) in &flat {
+            assert_eq!(Params::default().with_value(n, v.clone()).unwrap(), Params::default(), "{n}");
+        }
     }
 
     #[test]

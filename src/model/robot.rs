@@ -110,6 +110,28 @@ impl JointModel {
     }
 }
 
+/// Joint positions that forward kinematics cannot use.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
+pub enum PositionsError {
+    /// Not one position per joint of the model.
+    #[error("{got} joint positions for a model of {expected} joints")]
+    Length {
+        /// Joints of the model.
+        expected: usize,
+        /// Positions given.
+        got: usize,
+    },
+    /// A position is NaN or infinite.
+    #[error("joint '{joint}' has a non-finite position {value}")]
+    NonFinite {
+        /// The joint.
+        joint: String,
+        /// Its value.
+        value: f64,
+    },
+}
+
 /// A URDF that cannot be used.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -335,7 +357,15 @@ impl RobotModel {
     /// The world pose of every link, given a position for every joint (indexed like `joints`;
     /// ignored for fixed, floating and planar joints and for mimics, whose value is derived) and
     /// the pose of the root link in the world.
-    pub fn forward_kinematics(&self, positions: &[f64], base: &Isometry3<f64>) -> Vec<Isometry3<f64>> {
+    ///
+    /// A slice of the wrong length, or a non-finite position, is an error naming it.
+    pub fn forward_kinematics(&self, positions: &[f64], base: &Isometry3<f64>) -> Result<Vec<Isometry3<f64>>, PositionsError> {
+        if positions.len() != self.joints.len() {
+            return Err(PositionsError::Length { expected: self.joints.len(), got: positions.len() });
+        }
+        if let Some((j, v)) = positions.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(PositionsError::NonFinite { joint: self.joints[j].name.clone(), value: *v });
+        }
         let mut poses = vec![Isometry3::identity(); self.links.len()];
         poses[self.root] = *base;
         for &ji in &self.order {
@@ -351,6 +381,6 @@ impl RobotModel {
             };
             poses[j.child] = poses[j.parent] * j.origin * motion;
         }
-        poses
+        Ok(poses)
     }
 }

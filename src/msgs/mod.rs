@@ -1,14 +1,13 @@
-//! ROS 2 message types as serde structs (CDR via `cdr-encoding`), shared by the node and the bag
-//! replay, and their `.msg` definitions (the MCAP `ros2msg` schemas).
+//! ROS 2 message types as plain serde structs, shared by the node (ros2-client serialises them)
+//! and the bag replay (CDR in `replay`), and their `.msg` definitions (the MCAP `ros2msg`
+//! schemas). Nothing here depends on the rest of the crate.
 //!
 //! Field order is wire order: CDR has no field names. The project's own messages mirror
-//! `interfaces/thickness_collision_msgs/msg/*.msg`; `tests/msgs_cdr.rs` checks both against
-//! rosbags' serializer.
+//! `interfaces/thickness_collision_msgs/msg/*.msg`; `tests/msgs_interface.rs` checks the field
+//! order, and the replay tests read what `replay` writes back with rosbags.
 
-mod cdr;
 mod definitions;
 
-pub use self::cdr::{decode_cdr, encode_cdr_le, CdrError};
 pub use self::definitions::{full_definition, COLLISION_REPORT_TYPE};
 
 use serde::{Deserialize, Serialize};
@@ -127,7 +126,7 @@ pub struct TfMessage {
 
 /// `thickness_collision_msgs/msg/Contact`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Contact {
+pub struct ContactMsg {
     /// Robot link.
     pub link_name: String,
     /// Environment object.
@@ -150,26 +149,11 @@ pub struct CollisionReport {
     /// Whether any checked link collides.
     pub in_collision: bool,
     /// At least one contact (the deepest) for every colliding link.
-    pub contacts: Vec<Contact>,
+    pub contacts: Vec<ContactMsg>,
     /// Time spent checking (seconds).
     pub check_seconds: f64,
-}
-
-impl CollisionReport {
-    /// The message for a checker's report.
-    pub fn from_state(report: &crate::checker::StateReport, header: Header) -> CollisionReport {
-        let v = |a: [f64; 3]| Vector3 { x: a[0], y: a[1], z: a[2] };
-        CollisionReport {
-            header,
-            in_collision: report.in_collision,
-            contacts: report
-                .contacts
-                .iter()
-                .map(|c| Contact { link_name: c.link_name.clone(), object_name: c.object_name.clone(), triangle: c.triangle, depth: c.depth, position: v(c.position), normal: v(c.normal) })
-                .collect(),
-            check_seconds: report.check_seconds,
-        }
-    }
+    /// Why the state could not be checked (then `in_collision` is true); empty when it was.
+    pub error: String,
 }
 
 /// `std_msgs/msg/ColorRGBA`.

@@ -1,6 +1,42 @@
 //! Reading rosbag2 bags: a directory with `metadata.yaml`, an `.mcap` file or a `.db3` file.
+//!
+//! Streaming: [`open_bag`] reads only what lists the topics (the MCAP summary section, the sqlite3
+//! `topics` table); the messages then come one at a time from the [`BagReader`] iterator, so the
+//! memory is bounded by the largest record, never by the size of the bag:
+//!
+//! - MCAP is read through a `BufReader<File>` by the `mcap` crate's sans-io [`LinearReader`]
+//!   (no memory map, no whole-file read), chunks (uncompressed, zstd or lz4) decompressed record by
+//!   record. A record longer than [`MAX_RECORD_BYTES`] is an error, and the reader's buffer grows
+//!   only with bytes actually read, so a corrupt length cannot allocate more than that.
+//! - sqlite3 rows come from a reader thread that owns the connection, over a channel bounded both
+//!   in messages ([`SQLITE_QUEUE`]) and in bytes ([`SQLITE_QUEUE_BYTES`]).
 
+use mcap::read::ChannelAccumulator;
+use mcap::records::{op, Record};
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+use mcap::McapError;
+use std::collections::{HashMap, HashSet};
+use std::fs::File;
+use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
+
+/// The longest record (MCAP) or message (sqlite3) this reader accepts: 256 MiB. A longer one is a
+/// corrupt length, or a message this replay has no use for; either way an error naming the file
+/// and the length, not an allocation of that size.
+pub const MAX_RECORD_BYTES: usize = 256 << 20;
+/// Bytes asked of the file at a time (the MCAP reader's buffer grows by at most this much more
+/// than the data it holds).
+const READ_PIECE: usize = 256 << 10;
+/// The `BufReader` over an MCAP file.
+const FILE_BUFFER: usize = 64 << 10;
+/// Messages queued between the sqlite3 reader thread and the iterator.
+pub const SQLITE_QUEUE: usize = 256;
+/// Payload bytes queued between the sqlite3 reader thread and the iterator (one larger message
+/// still passes, alone).
+pub const SQLITE_QUEUE_BYTES: usize = 16 << 20;
 
 /// One recorded message.
 #[derive(Clone, Debug)]
@@ -28,12 +64,12 @@ pub enum BagError {
     /// metadata.yaml is malformed or names a storage this reader does not know.
     #[error("{0}/metadata.yaml: {1}")]
     Metadata(PathBuf, String),
-    /// The MCAP file is corrupt or truncated (at the given message count).
+    /// The MCAP file is corrupt or truncated (after the given number of messages of that file).
     #[error("{path}: corrupt or truncated MCAP after {after} messages: {message}")]
     Mcap {
         /// File.
         path: PathBuf,
-        /// Messages read before the fault.
+        /// Messages of this file read before the fault.
         after: usize,
         /// What the reader said.
         message: String,
@@ -43,129 +79,926 @@ pub enum BagError {
     Sqlite {
         /// File.
         path: PathBuf,
-        /// Messages read before the fault.
+        /// Messages of this file read before the fault.
         after: usize,
         /// What SQLite said.
         message: String,
     },
 }
 
-/// The messages of a bag in storage order, then the error that ended it early, if any.
-pub struct BagReader {
-    /// Messages read.
-    pub messages: Vec<BagMessage>,
-    /// The fault that stopped reading (a truncated or corrupt tail).
-    pub error: Option<BagError>,
-    /// The topics and their types, as declared by the bag.
-    pub topics: Vec<(String, String)>,
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Storage {
+    Mcap,
+    Sqlite,
 }
 
-/// Opens a bag and reads all its messages (the fault of a corrupt tail is kept in `error`).
+/// An open bag: its topics, and its messages in storage order as an iterator (MCAP: file order;
+/// sqlite3: by timestamp, then row id; the files of a directory one after the other).
+///
+/// The iterator yields `Err` once, at the fault that ends a corrupt or truncated file (after the
+/// good messages before it), and `None` from then on.
+pub struct BagReader {
+    storage: Storage,
+    files: Vec<PathBuf>,
+    next_file: usize,
+    current: Option<Source>,
+    topics: Vec<(String, String)>,
+    topics_fault: Option<BagError>,
+    done: bool,
+}
+
+enum Source {
+    Mcap(Box<McapStream>),
+    Sqlite(SqliteStream),
+}
+
+impl BagReader {
+    /// Topics and their types as declared by the bag (all files, first declaration first), known
+    /// right after [`open_bag`]. MCAP: from each file's summary section; a file without one (a
+    /// recording that was cut off, or a writer that writes none) is scanned once at open for its
+    /// channel records. sqlite3: each file's `topics` table.
+    pub fn topics(&self) -> &[(String, String)] {
+        &self.topics
+    }
+
+    /// The fault that stopped the scan for topics in an MCAP file without a summary: `topics()`
+    /// then holds the topics declared before it (the iterator reports the same fault again when it
+    /// gets there). `None` when the topics are complete.
+    pub fn topics_fault(&self) -> Option<&BagError> {
+        self.topics_fault.as_ref()
+    }
+}
+
+impl std::fmt::Debug for BagReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BagReader")
+            .field("storage", &self.storage)
+            .field("files", &self.files)
+            .field("topics", &self.topics)
+            .field("topics_fault", &self.topics_fault)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Iterator for BagReader {
+    type Item = Result<BagMessage, BagError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        loop {
+            if self.current.is_none() {
+                let Some(file) = self.files.get(self.next_file) else {
+                    self.done = true;
+                    return None;
+                };
+                self.next_file += 1;
+                let source = match self.storage {
+                    Storage::Mcap => McapStream::open(file).map(|s| Source::Mcap(Box::new(s))),
+                    Storage::Sqlite => SqliteStream::start(file).map(Source::Sqlite),
+                };
+                match source {
+                    Ok(s) => self.current = Some(s),
+                    Err(e) => {
+                        self.done = true;
+                        return Some(Err(e));
+                    }
+                }
+            }
+            let item = match self.current.as_mut() {
+                Some(Source::Mcap(s)) => s.next(),
+                Some(Source::Sqlite(s)) => s.next(),
+                None => None,
+            };
+            match item {
+                Some(Ok(m)) => return Some(Ok(m)),
+                Some(Err(e)) => {
+                    self.done = true;
+                    self.current = None;
+                    return Some(Err(e));
+                }
+                None => self.current = None,
+            }
+        }
+    }
+}
+
+impl std::iter::FusedIterator for BagReader {}
+
+/// Opens a bag: checks the files, reads the topics, reads no messages (iterate for those).
 pub fn open_bag(path: &Path) -> Result<BagReader, BagError> {
-    if path.is_dir() {
+    let (storage, files) = if path.is_dir() {
         let meta_path = path.join("metadata.yaml");
         let text = std::fs::read_to_string(&meta_path).map_err(|_| BagError::UnknownFormat(path.to_owned()))?;
-        let meta: serde_yaml::Value = serde_yaml::from_str(&text).map_err(|e| BagError::Metadata(path.to_owned(), e.to_string()))?;
+        let meta: serde_yaml_ng::Value = serde_yaml_ng::from_str(&text).map_err(|e| BagError::Metadata(path.to_owned(), e.to_string()))?;
         let info = &meta["rosbag2_bagfile_information"];
-        let storage = info["storage_identifier"].as_str().unwrap_or("");
-        let files: Vec<PathBuf> = info["relative_file_paths"].as_sequence().map(|s| s.iter().filter_map(|f| f.as_str()).map(|f| path.join(f)).collect()).unwrap_or_default();
+        let files: Vec<PathBuf> =
+            info["relative_file_paths"].as_sequence().map(|s| s.iter().filter_map(|f| f.as_str()).map(|f| path.join(f)).collect()).unwrap_or_default();
         if files.is_empty() {
             return Err(BagError::Metadata(path.to_owned(), "relative_file_paths is empty or missing".into()));
         }
-        let mut all = BagReader { messages: Vec::new(), error: None, topics: Vec::new() };
-        for file in files {
-            let part = match storage {
-                "mcap" => read_mcap(&file)?,
-                "sqlite3" => read_sqlite(&file)?,
-                other => return Err(BagError::Metadata(path.to_owned(), format!("unknown storage_identifier '{other}' (expected mcap or sqlite3)"))),
-            };
-            all.messages.extend(part.messages);
-            for t in part.topics {
-                if !all.topics.contains(&t) {
-                    all.topics.push(t);
-                }
-            }
-            if part.error.is_some() {
-                all.error = part.error;
-                break;
-            }
-        }
-        return Ok(all);
-    }
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("mcap") => read_mcap(path),
-        Some("db3") => read_sqlite(path),
-        _ if !path.exists() => Err(BagError::Io(path.to_owned(), std::io::Error::from(std::io::ErrorKind::NotFound))),
-        _ => Err(BagError::UnknownFormat(path.to_owned())),
-    }
-}
-
-fn read_mcap(path: &Path) -> Result<BagReader, BagError> {
-    let buf = std::fs::read(path).map_err(|e| BagError::Io(path.to_owned(), e))?;
-    let mut out = BagReader { messages: Vec::new(), error: None, topics: Vec::new() };
-    let stream = match mcap::MessageStream::new(&buf) {
-        Ok(s) => s,
-        Err(e) => {
-            out.error = Some(BagError::Mcap { path: path.to_owned(), after: 0, message: e.to_string() });
-            return Ok(out);
+        let storage = match info["storage_identifier"].as_str().unwrap_or("") {
+            "mcap" => Storage::Mcap,
+            "sqlite3" => Storage::Sqlite,
+            other => return Err(BagError::Metadata(path.to_owned(), format!("unknown storage_identifier '{other}' (expected mcap or sqlite3)"))),
+        };
+        (storage, files)
+    } else {
+        match path.extension().and_then(|e| e.to_str()) {
+            Some("mcap") => (Storage::Mcap, vec![path.to_owned()]),
+            Some("db3") => (Storage::Sqlite, vec![path.to_owned()]),
+            _ if !path.exists() => return Err(BagError::Io(path.to_owned(), std::io::Error::from(std::io::ErrorKind::NotFound))),
+            _ => return Err(BagError::UnknownFormat(path.to_owned())),
         }
     };
-    for item in stream {
-        match item {
-            Ok(m) => {
-                let type_name = m.channel.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default();
-                let topic = (m.channel.topic.clone(), type_name.clone());
-                if !out.topics.contains(&topic) {
-                    out.topics.push(topic);
-                }
-                out.messages.push(BagMessage { topic: m.channel.topic.clone(), type_name, log_time: m.log_time as i64, data: m.data.into_owned() });
-            }
-            Err(e) => {
-                out.error = Some(BagError::Mcap { path: path.to_owned(), after: out.messages.len(), message: e.to_string() });
-                break;
+    let mut topics = Vec::new();
+    let mut seen = HashSet::new();
+    let mut topics_fault = None;
+    for file in &files {
+        let (declared, fault) = match storage {
+            Storage::Mcap => mcap_topics(file)?,
+            Storage::Sqlite => (sqlite_topics(file)?, None),
+        };
+        for t in declared {
+            if seen.insert(t.clone()) {
+                topics.push(t);
             }
         }
+        if fault.is_some() {
+            // The iterator stops at this fault too: the files after it are never read.
+            topics_fault = fault;
+            break;
+        }
     }
-    Ok(out)
+    Ok(BagReader { storage, files, next_file: 0, current: None, topics, topics_fault, done: false })
 }
 
-fn read_sqlite(path: &Path) -> Result<BagReader, BagError> {
+// ---------------------------------------------------------------------------------------------
+// MCAP
+
+/// (topic, type) pairs.
+type Topics = Vec<(String, String)>;
+
+/// Why a pass over an MCAP file stopped early.
+enum Fault {
+    Io(std::io::Error),
+    Mcap(McapError),
+    Bad(String),
+}
+
+impl From<McapError> for Fault {
+    fn from(e: McapError) -> Self {
+        Fault::Mcap(e)
+    }
+}
+
+impl Fault {
+    fn into_bag_error(self, path: &Path, after: usize) -> BagError {
+        let message = match self {
+            Fault::Io(e) => return BagError::Io(path.to_owned(), e),
+            Fault::Mcap(McapError::RecordTooLarge { opcode, len }) => {
+                format!("a record (opcode {opcode:#04x}) claims {len} bytes, more than this reader's limit of {} MiB per record", MAX_RECORD_BYTES >> 20)
+            }
+            Fault::Mcap(McapError::ChunkTooLarge(len)) => {
+                format!("a chunk claims {len} bytes, more than this reader's limit of {} MiB per record", MAX_RECORD_BYTES >> 20)
+            }
+            Fault::Mcap(e) => match std::error::Error::source(&e) {
+                Some(s) => format!("{e}: {s}"),
+                None => e.to_string(),
+            },
+            Fault::Bad(s) => s,
+        };
+        BagError::Mcap { path: path.to_owned(), after, message }
+    }
+}
+
+/// Feeds an MCAP file to the sans-io linear reader, a bounded piece at a time.
+struct Pump {
+    src: BufReader<File>,
+    reader: LinearReader,
+}
+
+impl Pump {
+    fn new(file: File, options: LinearReaderOptions) -> Self {
+        Pump { src: BufReader::with_capacity(FILE_BUFFER, file), reader: LinearReader::new_with_options(options) }
+    }
+
+    /// Hands the records to `on` until it returns `Some`; `Ok(None)` at the clean end of the file.
+    fn next_record<T>(&mut self, mut on: impl FnMut(u8, &[u8]) -> Result<Option<T>, Fault>) -> Result<Option<T>, Fault> {
+        loop {
+            let want = match self.reader.next_event() {
+                None => return Ok(None),
+                Some(Err(e)) => return Err(Fault::Mcap(e)),
+                Some(Ok(LinearReadEvent::ReadRequest(n))) => n,
+                Some(Ok(LinearReadEvent::Record { opcode, data })) => {
+                    if let Some(t) = on(opcode, data)? {
+                        return Ok(Some(t));
+                    }
+                    continue;
+                }
+            };
+            // Never more than READ_PIECE at once: the reader's buffer is sized by the request, and
+            // a corrupt length must not size it beyond the bytes the file really has.
+            let buf = self.reader.insert(want.clamp(1, READ_PIECE));
+            let n = loop {
+                match self.src.read(buf) {
+                    Ok(n) => break n,
+                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                    Err(e) => return Err(Fault::Io(e)),
+                }
+            };
+            self.reader.notify_read(n);
+        }
+    }
+}
+
+/// Checks that the length-prefixed strings of a schema or channel record fit in the record before
+/// the `mcap` crate parses it (its parser reserves a string's claimed length up front: up to 4 GiB
+/// from one corrupt u32).
+fn check_strings(opcode: u8, body: &[u8]) -> Result<(), Fault> {
+    fn string(body: &[u8], pos: &mut usize, end: usize) -> Option<()> {
+        let len = u32::from_le_bytes(body.get(*pos..*pos + 4)?.try_into().ok()?) as usize;
+        *pos = pos.checked_add(4)?.checked_add(len)?;
+        (*pos <= end).then_some(())
+    }
+    let ok = || -> Option<()> {
+        let mut pos = match opcode {
+            op::SCHEMA => 2,
+            op::CHANNEL => 4,
+            _ => return Some(()),
+        };
+        string(body, &mut pos, body.len())?;
+        string(body, &mut pos, body.len())?;
+        if opcode == op::CHANNEL {
+            let map_len = u32::from_le_bytes(body.get(pos..pos + 4)?.try_into().ok()?) as usize;
+            pos += 4;
+            let end = pos.checked_add(map_len)?;
+            if end > body.len() {
+                return None;
+            }
+            while pos < end {
+                string(body, &mut pos, end)?;
+                string(body, &mut pos, end)?;
+            }
+        }
+        Some(())
+    };
+    ok().ok_or_else(|| Fault::Bad(format!("a {} record's strings overrun its {} bytes", if opcode == op::SCHEMA { "schema" } else { "channel" }, body.len())))
+}
+
+/// Schemas and channels as declared, for the topic list (lenient: no cross-checks, which the
+/// message pass does).
+#[derive(Default)]
+struct Declared {
+    schemas: HashMap<u16, String>,
+    channel_ids: HashSet<u16>,
+    channels: Vec<(String, u16)>,
+}
+
+impl Declared {
+    fn add(&mut self, opcode: u8, body: &[u8]) -> Result<(), Fault> {
+        if opcode != op::SCHEMA && opcode != op::CHANNEL {
+            return Ok(());
+        }
+        check_strings(opcode, body)?;
+        match mcap::parse_record(opcode, body)? {
+            Record::Schema { header, .. } => {
+                let _ = self.schemas.entry(header.id).or_insert(header.name);
+            }
+            Record::Channel(c) if self.channel_ids.insert(c.id) => self.channels.push((c.topic, c.schema_id)),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn topics(self) -> Topics {
+        let schemas = self.schemas;
+        self.channels.into_iter().map(|(topic, schema)| (topic, schemas.get(&schema).cloned().unwrap_or_default())).collect()
+    }
+}
+
+/// The topics of an MCAP file, and the fault that cut the scan short when there was no summary.
+fn mcap_topics(path: &Path) -> Result<(Topics, Option<BagError>), BagError> {
+    let io = |e| BagError::Io(path.to_owned(), e);
+    let file = File::open(path).map_err(io)?;
+    let size = file.metadata().map_err(io)?.len();
+    if let Some(topics) = summary_topics(file, size) {
+        return Ok((topics, None));
+    }
+    // No usable summary: one pass over the channel records (data bytes are skipped, but chunks
+    // have to be decompressed to find the records in them).
+    let mut pump = Pump::new(File::open(path).map_err(io)?, LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES));
+    let mut declared = Declared::default();
+    let (mut records, mut messages) = (0usize, 0usize);
+    let scan = pump.next_record(|opcode, body| {
+        records += 1;
+        match opcode {
+            op::DATA_END => return Ok(Some(())),
+            op::MESSAGE => messages += 1,
+            _ => declared.add(opcode, body)?,
+        }
+        Ok(None)
+    });
+    match scan {
+        Ok(_) => Ok((declared.topics(), None)),
+        // Not even the header: not an MCAP file (or an empty one).
+        Err(e) if records == 0 => Err(e.into_bag_error(path, 0)),
+        Err(e) => Ok((declared.topics(), Some(e.into_bag_error(path, messages)))),
+    }
+}
+
+/// The topics from the summary section, or `None` when there is no usable one.
+fn summary_topics(mut file: File, size: u64) -> Option<Topics> {
+    // Footer record (opcode, length, summary start, summary offset start, CRC) and end magic.
+    const TAIL: usize = 1 + 8 + 8 + 8 + 4 + 8;
+    let magic = mcap::MAGIC.len() as u64;
+    if size < magic + TAIL as u64 {
+        return None;
+    }
+    let footer_at = size - TAIL as u64;
+    let _ = file.seek(SeekFrom::Start(footer_at)).ok()?;
+    let mut tail = [0u8; TAIL];
+    file.read_exact(&mut tail).ok()?;
+    let field = |at: usize| tail.get(at..at + 8).and_then(|b| b.try_into().ok()).map(u64::from_le_bytes);
+    if tail[0] != op::FOOTER || field(1)? != 20 || &tail[TAIL - 8..] != mcap::MAGIC {
+        return None;
+    }
+    let summary_start = field(9)?;
+    if summary_start < magic || summary_start >= footer_at {
+        return None;
+    }
+    let _ = file.seek(SeekFrom::Start(summary_start)).ok()?;
+    let limit = usize::try_from(footer_at - summary_start).unwrap_or(usize::MAX).min(MAX_RECORD_BYTES);
+    let mut pump = Pump::new(file, LinearReaderOptions::default().with_skip_start_magic(true).with_record_length_limit(limit));
+    let mut declared = Declared::default();
+    let end = pump.next_record(|opcode, body| {
+        if opcode == op::FOOTER {
+            return Ok(Some(()));
+        }
+        declared.add(opcode, body)?;
+        Ok(None)
+    });
+    // A summary that does not run into the footer, or lists no channels, is not used.
+    (matches!(end, Ok(Some(()))) && !declared.channels.is_empty()).then(|| declared.topics())
+}
+
+/// The messages of one MCAP file.
+struct McapStream {
+    path: PathBuf,
+    pump: Pump,
+    channels: ChannelAccumulator<'static>,
+    past_data_end: bool,
+    read: usize,
+}
+
+impl McapStream {
+    fn open(path: &Path) -> Result<Self, BagError> {
+        let file = File::open(path).map_err(|e| BagError::Io(path.to_owned(), e))?;
+        let options = LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES).with_validate_chunk_crcs(true);
+        Ok(McapStream { path: path.to_owned(), pump: Pump::new(file, options), channels: ChannelAccumulator::default(), past_data_end: false, read: 0 })
+    }
+
+    fn next(&mut self) -> Option<Result<BagMessage, BagError>> {
+        let Self { pump, channels, past_data_end, .. } = self;
+        // Read on to the end magic after the data end record (the summary is skipped, not parsed),
+        // so that a truncated tail is reported.
+        let next = pump.next_record(|opcode, body| {
+            if *past_data_end {
+                return if opcode == op::MESSAGE { Err(Fault::Bad("a message record after the data end record".into())) } else { Ok(None) };
+            }
+            match opcode {
+                op::DATA_END => *past_data_end = true,
+                op::SCHEMA | op::CHANNEL => {
+                    check_strings(opcode, body)?;
+                    match mcap::parse_record(opcode, body)? {
+                        Record::Schema { header, data } => channels.add_schema_from_slice(header, &data)?,
+                        Record::Channel(c) => channels.add_channel(c)?,
+                        _ => {}
+                    }
+                }
+                op::MESSAGE => {
+                    if let Record::Message { header, data } = mcap::parse_record(opcode, body)? {
+                        let channel = channels.get(header.channel_id).ok_or(McapError::UnknownChannel(header.sequence, header.channel_id))?;
+                        return Ok(Some(BagMessage {
+                            topic: channel.topic.clone(),
+                            type_name: channel.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default(),
+                            log_time: i64::try_from(header.log_time).unwrap_or(i64::MAX),
+                            data: data.into_owned(),
+                        }));
+                    }
+                }
+                _ => {}
+            }
+            Ok(None)
+        });
+        match next {
+            Ok(Some(m)) => {
+                self.read += 1;
+                Some(Ok(m))
+            }
+            Ok(None) => None,
+            Err(e) => Some(Err(e.into_bag_error(&self.path, self.read))),
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// sqlite3
+
+fn sqlite_open(path: &Path) -> Result<rusqlite::Connection, BagError> {
     if !path.is_file() {
         return Err(BagError::Io(path.to_owned(), std::io::Error::from(std::io::ErrorKind::NotFound)));
     }
-    let mut out = BagReader { messages: Vec::new(), error: None, topics: Vec::new() };
-    let fail = |after: usize, e: rusqlite::Error| BagError::Sqlite { path: path.to_owned(), after, message: e.to_string() };
-    let db = rusqlite::Connection::open_with_flags(path, rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY | rusqlite::OpenFlags::SQLITE_OPEN_NO_MUTEX).map_err(|e| fail(0, e))?;
-    let mut topics = std::collections::HashMap::new();
-    {
-        let mut stmt = db.prepare("SELECT id, name, type FROM topics").map_err(|e| fail(0, e))?;
-        let rows = stmt.query_map([], |r| Ok((r.get::<_, i64>(0)?, r.get::<_, String>(1)?, r.get::<_, String>(2)?))).map_err(|e| fail(0, e))?;
-        for row in rows {
-            let (id, name, ty) = row.map_err(|e| fail(0, e))?;
-            out.topics.push((name.clone(), ty.clone()));
-            let _ = topics.insert(id, (name, ty));
+    rusqlite::Connection::open_with_flags(path, rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY | rusqlite::OpenFlags::SQLITE_OPEN_NO_MUTEX)
+        .map_err(|e| BagError::Sqlite { path: path.to_owned(), after: 0, message: e.to_string() })
+}
+
+fn sqlite_topic_rows(db: &rusqlite::Connection) -> rusqlite::Result<Vec<(i64, String, String)>> {
+    let mut stmt = db.prepare("SELECT id, name, type FROM topics ORDER BY id")?;
+    let rows = stmt.query_map([], |r| Ok((r.get::<_, i64>(0)?, r.get::<_, String>(1)?, r.get::<_, String>(2)?)))?;
+    rows.collect()
+}
+
+fn sqlite_topics(path: &Path) -> Result<Topics, BagError> {
+    let db = sqlite_open(path)?;
+    let rows = sqlite_topic_rows(&db).map_err(|e| BagError::Sqlite { path: path.to_owned(), after: 0, message: e.to_string() })?;
+    Ok(rows.into_iter().map(|(_, name, ty)| (name, ty)).collect())
+}
+
+/// What the sqlite3 reader thread sends.
+enum Row {
+    Message(BagMessage),
+    Fault(String),
+    End,
+}
+
+/// The byte budget of the queue: the thread waits while more than SQLITE_QUEUE_BYTES are queued.
+#[derive(Default)]
+struct Flow {
+    state: Mutex<FlowState>,
+    cv: Condvar,
+}
+
+#[derive(Default)]
+struct FlowState {
+    bytes: usize,
+    closed: bool,
+}
+
+impl Flow {
+    /// Waits for room for `n` bytes; false once the iterator is gone.
+    fn acquire(&self, n: usize) -> bool {
+        let Ok(mut s) = self.state.lock() else { return false };
+        while !s.closed && s.bytes > 0 && s.bytes.saturating_add(n) > SQLITE_QUEUE_BYTES {
+            s = match self.cv.wait(s) {
+                Ok(s) => s,
+                Err(_) => return false,
+            };
+        }
+        if s.closed {
+            return false;
+        }
+        s.bytes += n;
+        true
+    }
+
+    fn release(&self, n: usize) {
+        if let Ok(mut s) = self.state.lock() {
+            s.bytes = s.bytes.saturating_sub(n);
+        }
+        self.cv.notify_one();
+    }
+
+    fn close(&self) {
+        if let Ok(mut s) = self.state.lock() {
+            s.closed = true;
+        }
+        self.cv.notify_all();
+    }
+}
+
+/// The messages of one sqlite3 file, read row by row by a thread that owns the connection.
+struct SqliteStream {
+    path: PathBuf,
+    rx: Option<Receiver<Row>>,
+    flow: Arc<Flow>,
+    thread: Option<JoinHandle<()>>,
+    read: usize,
+}
+
+impl SqliteStream {
+    fn start(path: &Path) -> Result<Self, BagError> {
+        let db = sqlite_open(path)?;
+        let (tx, rx) = sync_channel(SQLITE_QUEUE);
+        let flow = Arc::new(Flow::default());
+        let thread = {
+            let flow = Arc::clone(&flow);
+            std::thread::Builder::new()
+                .name("bag-sqlite3".into())
+                .spawn(move || {
+                    let last = match send_rows(&db, &tx, &flow) {
+                        Ok(true) => Row::End,
+                        Ok(false) => return, // the iterator is gone
+                        Err(e) => Row::Fault(e),
+                    };
+                    let _ = tx.send(last);
+                })
+                .map_err(|e| BagError::Io(path.to_owned(), e))?
+        };
+        Ok(SqliteStream { path: path.to_owned(), rx: Some(rx), flow, thread: Some(thread), read: 0 })
+    }
+
+    fn next(&mut self) -> Option<Result<BagMessage, BagError>> {
+        let row = self.rx.as_ref()?.recv();
+        let fault = match row {
+            Ok(Row::Message(m)) => {
+                self.flow.release(m.data.len());
+                self.read += 1;
+                return Some(Ok(m));
+            }
+            Ok(Row::End) => None,
+            Ok(Row::Fault(message)) => Some(message),
+            Err(_) => Some("the sqlite3 reader thread stopped without finishing".to_owned()),
+        };
+        self.rx = None;
+        fault.map(|message| Err(BagError::Sqlite { path: self.path.clone(), after: self.read, message }))
+    }
+}
+
+impl Drop for SqliteStream {
+    fn drop(&mut self) {
+        // Unblock the thread wherever it waits (byte budget or a full queue), then wait for it so
+        // that the connection is closed when the reader is.
+        self.flow.close();
+        self.rx = None;
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
         }
     }
-    let mut stmt = db.prepare("SELECT topic_id, timestamp, data FROM messages ORDER BY timestamp, id").map_err(|e| fail(0, e))?;
-    let rows = stmt.query_map([], |r| Ok((r.get::<_, i64>(0)?, r.get::<_, i64>(1)?, r.get::<_, Vec<u8>>(2)?)));
-    let rows = match rows {
-        Ok(r) => r,
-        Err(e) => {
-            out.error = Some(fail(0, e));
-            return Ok(out);
+}
+
+/// The reader thread: every row in timestamp order. Ok(false) when the iterator went away.
+fn send_rows(db: &rusqlite::Connection, tx: &SyncSender<Row>, flow: &Flow) -> Result<bool, String> {
+    let topics: HashMap<i64, (String, String)> = sqlite_topic_rows(db).map_err(|e| e.to_string())?.into_iter().map(|(id, name, ty)| (id, (name, ty))).collect();
+    let mut stmt = db.prepare("SELECT topic_id, timestamp, length(data), data FROM messages ORDER BY timestamp, id").map_err(|e| e.to_string())?;
+    let mut rows = stmt.query([]).map_err(|e| e.to_string())?;
+    while let Some(row) = rows.next().map_err(|e| e.to_string())? {
+        let tid: i64 = row.get(0).map_err(|e| e.to_string())?;
+        let log_time: i64 = row.get(1).map_err(|e| e.to_string())?;
+        // length() reads the record header only: a long blob is refused before it is loaded.
+        let len: Option<i64> = row.get(2).map_err(|e| e.to_string())?;
+        if len.is_some_and(|n| usize::try_from(n).map_or(true, |n| n > MAX_RECORD_BYTES)) {
+            return Err(format!(
+                "the message at {log_time} ns has {} bytes, more than this reader's limit of {} MiB per message",
+                len.unwrap_or_default(),
+                MAX_RECORD_BYTES >> 20
+            ));
         }
-    };
-    for row in rows {
-        match row {
-            Ok((tid, ts, data)) => {
-                let (topic, type_name) = topics.get(&tid).cloned().unwrap_or_else(|| (format!("<unknown topic id {tid}>"), String::new()));
-                out.messages.push(BagMessage { topic, type_name, log_time: ts, data });
-            }
-            Err(e) => {
-                out.error = Some(fail(out.messages.len(), e));
-                break;
-            }
+        let data: Vec<u8> = row.get(3).map_err(|e| e.to_string())?;
+        let (topic, type_name) = topics.get(&tid).cloned().unwrap_or_else(|| (format!("<unknown topic id {tid}>"), String::new()));
+        if !flow.acquire(data.len()) || tx.send(Row::Message(BagMessage { topic, type_name, log_time, data })).is_err() {
+            return Ok(false);
         }
     }
-    Ok(out)
+    Ok(true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeMap;
+    use std::io::Cursor;
+
+    fn scratch(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("tc_bag_reader_{}_{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// An MCAP file with two topics (the second declared after messages of the first).
+    fn write_mcap(opts: mcap::WriteOptions, n: usize) -> Vec<u8> {
+        let mut buf = Cursor::new(Vec::new());
+        {
+            let mut w = opts.create(&mut buf).unwrap();
+            let s = w.add_schema("sensor_msgs/msg/JointState", "ros2msg", b"float64[] position").unwrap();
+            let js = w.add_channel(s, "/joint_states", "cdr", &BTreeMap::new()).unwrap();
+            for k in 0..n {
+                w.write_to_known_channel(
+                    &mcap::records::MessageHeader { channel_id: js, sequence: k as u32, log_time: 1000 + k as u64, publish_time: 0 },
+                    &payload(k),
+                )
+                .unwrap();
+                if k == n / 2 {
+                    let s2 = w.add_schema("std_msgs/msg/String", "ros2msg", b"string data").unwrap();
+                    let c2 = w.add_channel(s2, "/robot_description", "cdr", &BTreeMap::new()).unwrap();
+                    w.write_to_known_channel(
+                        &mcap::records::MessageHeader { channel_id: c2, sequence: 0, log_time: 1000 + k as u64, publish_time: 0 },
+                        b"urdf",
+                    )
+                    .unwrap();
+                }
+            }
+            let _ = w.finish().unwrap();
+        }
+        buf.into_inner()
+    }
+
+    fn payload(k: usize) -> Vec<u8> {
+        (0..(k % 97) + 8).map(|i| (i * 31 + k) as u8).collect()
+    }
+
+    fn all(r: BagReader) -> (Vec<BagMessage>, Option<BagError>) {
+        let mut msgs = Vec::new();
+        let mut r = r;
+        for m in r.by_ref() {
+            match m {
+                Ok(m) => msgs.push(m),
+                Err(e) => {
+                    assert!(r.next().is_none(), "nothing after an error");
+                    return (msgs, Some(e));
+                }
+            }
+        }
+        (msgs, None)
+    }
+
+    /// What mcap's whole-buffer MessageStream reads.
+    fn reference(bytes: &[u8]) -> Vec<(String, String, i64, Vec<u8>)> {
+        mcap::MessageStream::new(bytes)
+            .unwrap()
+            .map(|m| m.unwrap())
+            .map(|m| (m.channel.topic.clone(), m.channel.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default(), m.log_time as i64, m.data.into_owned()))
+            .collect()
+    }
+
+    fn same(got: &[BagMessage], want: &[(String, String, i64, Vec<u8>)]) {
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(want) {
+            assert_eq!((&g.topic, &g.type_name, g.log_time, &g.data), (&w.0, &w.1, w.2, &w.3));
+        }
+    }
+
+    const TOPICS: [(&str, &str); 2] = [("/joint_states", "sensor_msgs/msg/JointState"), ("/robot_description", "std_msgs/msg/String")];
+
+    fn topics_are(r: &BagReader, want: &[(&str, &str)]) {
+        let got: Vec<(&str, &str)> = r.topics().iter().map(|(a, b)| (a.as_str(), b.as_str())).collect();
+        assert_eq!(got, want);
+    }
+
+    #[test]
+    fn mcap_layouts_stream_like_the_whole_file_reader() {
+        let d = scratch("layouts");
+        let layouts: Vec<(&str, mcap::WriteOptions)> = vec![
+            ("zstd", mcap::WriteOptions::new().compression(Some(mcap::Compression::Zstd)).chunk_size(Some(4096)).calculate_chunk_crcs(true)),
+            ("lz4", mcap::WriteOptions::new().compression(Some(mcap::Compression::Lz4)).chunk_size(Some(4096))),
+            ("plain_chunks", mcap::WriteOptions::new().compression(None).chunk_size(Some(4096))),
+            ("no_chunks", mcap::WriteOptions::new().use_chunks(false)),
+            ("no_summary", mcap::WriteOptions::new().compression(Some(mcap::Compression::Zstd)).chunk_size(Some(4096)).emit_summary_records(false)),
+        ];
+        for (name, opts) in layouts {
+            let bytes = write_mcap(opts, 3000);
+            let f = d.join(format!("{name}.mcap"));
+            std::fs::write(&f, &bytes).unwrap();
+            let r = open_bag(&f).unwrap();
+            topics_are(&r, &TOPICS);
+            assert!(r.topics_fault().is_none());
+            let (msgs, err) = all(r);
+            assert!(err.is_none(), "{name}: {err:?}");
+            same(&msgs, &reference(&bytes));
+            assert_eq!(msgs.len(), 3001, "{name}");
+        }
+    }
+
+    #[test]
+    fn truncated_mcap_keeps_the_messages_before_the_cut() {
+        let d = scratch("cut");
+        let bytes = write_mcap(mcap::WriteOptions::new().compression(Some(mcap::Compression::Zstd)).chunk_size(Some(4096)), 3000);
+        let f = d.join("cut.mcap");
+        std::fs::write(&f, &bytes[..bytes.len() * 6 / 10]).unwrap();
+        let r = open_bag(&f).unwrap();
+        // No summary: the topics declared before the cut, and the fault.
+        topics_are(&r, &TOPICS);
+        assert!(r.topics_fault().is_some_and(|e| e.to_string().contains("truncated")));
+        let (msgs, err) = all(r);
+        let err = err.expect("an error at the cut").to_string();
+        assert!(err.contains("cut.mcap") && err.contains("truncated") && err.contains("ended in the middle"), "{err}");
+        let want = reference(&bytes);
+        assert!(msgs.len() > 1000 && msgs.len() < 3000, "{}", msgs.len());
+        same(&msgs, &want[..msgs.len()]);
+        assert!(err.contains(&format!("after {} messages", msgs.len())), "{err}");
+
+        // Cut after the header record, before the first channel: no topics, the fault says why.
+        let header_end = 8 + 9 + u64::from_le_bytes(bytes[9..17].try_into().unwrap()) as usize;
+        std::fs::write(&f, &bytes[..header_end + 5]).unwrap();
+        let r = open_bag(&f).unwrap();
+        assert!(r.topics().is_empty() && r.topics_fault().is_some());
+        let (msgs, err) = all(r);
+        assert!(msgs.is_empty() && err.is_some());
+    }
+
+    /// The offset of the first message record of an unchunked file.
+    fn first_message(bytes: &[u8]) -> usize {
+        let mut pos = 8;
+        loop {
+            let len = u64::from_le_bytes(bytes[pos + 1..pos + 9].try_into().unwrap()) as usize;
+            if bytes[pos] == op::MESSAGE {
+                return pos;
+            }
+            pos += 9 + len;
+        }
+    }
+
+    #[test]
+    fn corrupt_lengths_are_errors_not_allocations() {
+        let d = scratch("lengths");
+        let bytes = write_mcap(mcap::WriteOptions::new().use_chunks(false), 200);
+        let at = first_message(&bytes);
+        let f = d.join("huge.mcap");
+        for (len, says) in [(1u64 << 40, "limit of 256 MiB"), (u64::MAX, "limit of 256 MiB"), (100 << 20, "ended in the middle")] {
+            let mut b = bytes.clone();
+            b[at + 1..at + 9].copy_from_slice(&len.to_le_bytes());
+            std::fs::write(&f, &b).unwrap();
+            // The summary is intact: topics come from it.
+            let r = open_bag(&f).unwrap();
+            topics_are(&r, &TOPICS);
+            let (msgs, err) = all(r);
+            let err = err.expect("an error").to_string();
+            assert!(msgs.is_empty() && err.contains("huge.mcap") && err.contains(says), "{err}");
+            if len != 100 << 20 {
+                assert!(err.contains(&len.to_string()), "{err}");
+            }
+        }
+        // A channel record whose topic claims 4 GiB.
+        let mut b = bytes.clone();
+        let mut pos = 8;
+        while b[pos] != op::CHANNEL {
+            pos += 9 + u64::from_le_bytes(b[pos + 1..pos + 9].try_into().unwrap()) as usize;
+        }
+        b[pos + 9 + 4..pos + 9 + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+        let cut = b.len() / 2;
+        std::fs::write(&f, &b[..cut]).unwrap(); // no summary: the scan meets the channel record too
+        let r = open_bag(&f).unwrap();
+        assert!(r.topics_fault().is_some_and(|e| e.to_string().contains("overrun")), "{:?}", r.topics_fault());
+        let (_, err) = all(r);
+        assert!(err.is_some_and(|e| e.to_string().contains("overrun")));
+    }
+
+    #[test]
+    fn not_an_mcap_file_fails_at_open() {
+        let d = scratch("notmcap");
+        let f = d.join("x.mcap");
+        std::fs::write(&f, b"definitely not an mcap file, only named like one").unwrap();
+        let e = open_bag(&f).unwrap_err().to_string();
+        assert!(e.contains("x.mcap") && e.contains("magic"), "{e}");
+        // Cut inside the header record: nothing readable either.
+        let bytes = write_mcap(mcap::WriteOptions::new(), 10);
+        std::fs::write(&f, &bytes[..12]).unwrap();
+        assert!(open_bag(&f).unwrap_err().to_string().contains("x.mcap"));
+        std::fs::write(&f, b"").unwrap();
+        assert!(open_bag(&f).is_err());
+        let e = open_bag(&d.join("missing.mcap")).unwrap_err().to_string();
+        assert!(e.contains("missing.mcap"), "{e}");
+        let t = d.join("notes.txt");
+        std::fs::write(&t, "x").unwrap();
+        assert!(open_bag(&t).unwrap_err().to_string().contains("unknown storage format"));
+    }
+
+    fn metadata(dir: &Path, storage: &str, files: &[&str]) {
+        let list: String = files.iter().map(|f| format!("\n    - {f}")).collect();
+        std::fs::write(
+            dir.join("metadata.yaml"),
+            format!("rosbag2_bagfile_information:\n  version: 8\n  storage_identifier: {storage}\n  relative_file_paths:{list}\n"),
+        )
+        .unwrap();
+    }
+
+    #[test]
+    fn a_directory_reads_its_files_in_order() {
+        let d = scratch("dir");
+        let a = write_mcap(mcap::WriteOptions::new().compression(Some(mcap::Compression::Zstd)), 500);
+        let mut b = Cursor::new(Vec::new());
+        {
+            let mut w = mcap::WriteOptions::new().create(&mut b).unwrap();
+            let s = w.add_schema("tf2_msgs/msg/TFMessage", "ros2msg", b"").unwrap();
+            let c = w.add_channel(s, "/tf", "cdr", &BTreeMap::new()).unwrap();
+            for k in 0..10u32 {
+                w.write_to_known_channel(
+                    &mcap::records::MessageHeader { channel_id: c, sequence: k, log_time: 5000 + u64::from(k), publish_time: 0 },
+                    &[k as u8; 3],
+                )
+                .unwrap();
+            }
+            let _ = w.finish().unwrap();
+        }
+        let b = b.into_inner();
+        std::fs::write(d.join("bag_0.mcap"), &a).unwrap();
+        std::fs::write(d.join("bag_1.mcap"), &b).unwrap();
+        metadata(&d, "mcap", &["bag_0.mcap", "bag_1.mcap"]);
+        let r = open_bag(&d).unwrap();
+        topics_are(&r, &[TOPICS[0], TOPICS[1], ("/tf", "tf2_msgs/msg/TFMessage")]);
+        let (msgs, err) = all(r);
+        assert!(err.is_none());
+        let mut want = reference(&a);
+        want.extend(reference(&b));
+        same(&msgs, &want);
+
+        metadata(&d, "mcap", &["bag_0.mcap", "gone.mcap"]);
+        assert!(open_bag(&d).unwrap_err().to_string().contains("gone.mcap"));
+        metadata(&d, "rosbag_v1", &["bag_0.mcap"]);
+        assert!(open_bag(&d).unwrap_err().to_string().contains("unknown storage_identifier"));
+        metadata(&d, "mcap", &[]);
+        assert!(open_bag(&d).unwrap_err().to_string().contains("relative_file_paths"));
+    }
+
+    fn write_db3(path: &Path, rows: &[(i64, i64, Vec<u8>)]) {
+        let db = rusqlite::Connection::open(path).unwrap();
+        db.execute_batch(
+            "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);
+             CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data BLOB NOT NULL);
+             CREATE INDEX timestamp_idx ON messages (timestamp ASC);
+             INSERT INTO topics VALUES (1, '/joint_states', 'sensor_msgs/msg/JointState', 'cdr', ''), (2, '/tf', 'tf2_msgs/msg/TFMessage', 'cdr', '');",
+        )
+        .unwrap();
+        let tx = db.unchecked_transaction().unwrap();
+        for (topic, t, data) in rows {
+            let _ = tx.execute("INSERT INTO messages (topic_id, timestamp, data) VALUES (?1, ?2, ?3)", rusqlite::params![topic, t, data]).unwrap();
+        }
+        tx.commit().unwrap();
+    }
+
+    #[test]
+    fn sqlite_streams_in_timestamp_order_and_stops_cleanly() {
+        let d = scratch("db3");
+        // Out of order on purpose, one topic id without a topic, some large rows (byte budget).
+        let mut rows: Vec<(i64, i64, Vec<u8>)> = (0..5000).map(|k| (1 + (k % 2), (k * 7919) % 5000, payload(k as usize))).collect();
+        rows.push((9, 100_000, vec![1, 2, 3]));
+        for k in 0..6 {
+            rows.push((2, 200_000 + k, vec![k as u8; 5 << 20]));
+        }
+        let f = d.join("bag.db3");
+        write_db3(&f, &rows);
+        let r = open_bag(&f).unwrap();
+        topics_are(&r, &[("/joint_states", "sensor_msgs/msg/JointState"), ("/tf", "tf2_msgs/msg/TFMessage")]);
+        let (msgs, err) = all(r);
+        assert!(err.is_none(), "{err:?}");
+        let mut want: Vec<&(i64, i64, Vec<u8>)> = rows.iter().collect();
+        want.sort_by_key(|r| r.1); // stable: equal timestamps keep their row order
+        assert_eq!(msgs.len(), want.len());
+        for (m, (topic, t, data)) in msgs.iter().zip(&want) {
+            assert_eq!((m.log_time, &m.data), (*t, data));
+            let name = match topic {
+                1 => "/joint_states",
+                2 => "/tf",
+                _ => "<unknown topic id 9>",
+            };
+            assert_eq!(m.topic, name);
+        }
+        // Dropping the reader half-way ends its thread (this would hang otherwise).
+        let mut r = open_bag(&f).unwrap();
+        assert!(r.nth(10).is_some_and(|m| m.is_ok()));
+        drop(r);
+        let mut r = open_bag(&f).unwrap();
+        assert!(r.nth(4999 + 3).is_some_and(|m| m.is_ok_and(|m| m.data.len() == 5 << 20)));
+        drop(r);
+
+        // A directory of two files.
+        write_db3(&d.join("b.db3"), &[(2, 1, vec![9])]);
+        metadata(&d, "sqlite3", &["bag.db3", "b.db3"]);
+        let (msgs, err) = all(open_bag(&d).unwrap());
+        assert!(err.is_none() && msgs.len() == rows.len() + 1 && msgs.last().is_some_and(|m| m.data == [9]));
+
+        // Not a database: an error at open naming the file.
+        let bad = d.join("bad.db3");
+        std::fs::write(&bad, b"this is not a database, it only has the name of one").unwrap();
+        let e = open_bag(&bad).unwrap_err().to_string();
+        assert!(e.contains("bad.db3"), "{e}");
+    }
+
+    #[test]
+    fn schema_and_channel_string_checks() {
+        let mut body = Vec::new();
+        body.extend_from_slice(&1u16.to_le_bytes());
+        body.extend_from_slice(&1u16.to_le_bytes());
+        for s in ["/t", "cdr"] {
+            body.extend_from_slice(&(s.len() as u32).to_le_bytes());
+            body.extend_from_slice(s.as_bytes());
+        }
+        let mut map = Vec::new();
+        for s in ["k", "v"] {
+            map.extend_from_slice(&(s.len() as u32).to_le_bytes());
+            map.extend_from_slice(s.as_bytes());
+        }
+        body.extend_from_slice(&(map.len() as u32).to_le_bytes());
+        body.extend_from_slice(&map);
+        assert!(check_strings(op::CHANNEL, &body).is_ok());
+        assert!(matches!(mcap::parse_record(op::CHANNEL, &body), Ok(Record::Channel(_))));
+        for at in [4, 10, 17, 21, 26] {
+            let mut b = body.clone();
+            b[at..at + 4].copy_from_slice(&0x7fff_ffffu32.to_le_bytes());
+            assert!(check_strings(op::CHANNEL, &b).is_err(), "{at}");
+        }
+        assert!(check_strings(op::CHANNEL, &body[..body.len() - 1]).is_err());
+    }
 }

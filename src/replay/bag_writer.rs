@@ -1,6 +1,7 @@
 //! Writing a rosbag2 bag: a directory with `metadata.yaml` and one `.mcap` file.
 
-use crate::msgs::{encode_cdr_le, full_definition, CollisionReport, COLLISION_REPORT_TYPE};
+use super::cdr::encode_cdr_le;
+use crate::msgs::{full_definition, CollisionReport, COLLISION_REPORT_TYPE};
 use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::io::BufWriter;

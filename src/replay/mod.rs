@@ -3,9 +3,11 @@
 //! rosbag2 bag with the `collisions` topic.
 
 mod bag_reader;
+mod cdr;
 mod bag_writer;
 mod replay_run;
 
 pub use self::bag_reader::{open_bag, BagError, BagMessage, BagReader};
 pub use self::bag_writer::BagWriter;
-pub use self::replay_run::{replay, PoseSource, ReplayOptions, ReplaySummary};
+pub use self::cdr::{decode_cdr, encode_cdr_le, CdrError};
+pub use self::replay_run::{replay, ReplayOptions, ReplaySummary};

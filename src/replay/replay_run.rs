@@ -1,43 +1,40 @@
-//! The replay loop: bag messages to states, states to reports, reports to JSON lines and a bag.
+//! The replay loop: the node's offline twin. Bag messages go, in storage order, through the same
+//! [`Pipeline`] the node feeds live; each checked state becomes a JSON line and/or a message in a
+//! new rosbag2 bag. The bag is streamed: memory is bounded by the model, not the recording.
 
 use super::bag_reader::{open_bag, BagMessage};
 use super::bag_writer::BagWriter;
-use crate::checker::{Checker, JointMemory, StateReport, TfTree};
-use crate::model::Params;
-use crate::msgs::{decode_cdr, CollisionReport, Header, JointState, StringMsg, TfMessage, Time};
+use super::cdr::decode_cdr;
+use crate::model::{Params, PoseSource};
+use crate::msgs::{JointState, StringMsg, TfMessage};
+use crate::pipeline::{CheckedState, Pipeline, Skip, SkipCause};
 use anyhow::{bail, Context, Result};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Where robot states come from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum PoseSource {
-    /// `sensor_msgs/JointState` through forward kinematics.
-    #[value(name = "joint_states")]
-    JointStates,
-    /// `tf2_msgs/TFMessage`: link poses composed up to `world_frame`.
-    #[value(name = "tf")]
-    Tf,
-}
+/// The topic a `robot_description` is recorded on.
+const DESCRIPTION_TOPIC: &str = "/robot_description";
 
 /// What to replay and where the results go.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct ReplayOptions {
     /// rosbag2 directory, `.mcap` or `.db3`.
     pub bag: PathBuf,
     /// Input topic (default `/joint_states`, or `/tf`).
     pub topic: Option<String>,
-    /// Where states come from.
-    pub pose_source: PoseSource,
+    /// Where states come from, overriding the parameters' `pose_source`.
+    pub pose_source: Option<PoseSource>,
+    /// The robot's `/tf` frame prefix, overriding the parameters' `frame_prefix`.
+    pub frame_prefix: Option<String>,
     /// Output rosbag2 directory with the `collisions` topic.
     pub out_dir: Option<PathBuf>,
     /// Output JSON lines, one report per state.
     pub jsonl: Option<PathBuf>,
-    /// Skip messages before this many seconds after the bag's first message.
+    /// Skip states before this many seconds after the bag's first message.
     pub start: Option<f64>,
-    /// Skip messages after this many seconds after the bag's first message.
+    /// Skip states after this many seconds after the bag's first message.
     pub end: Option<f64>,
     /// Show a progress bar (only drawn on a terminal).
     pub progress: bool,
@@ -48,12 +45,14 @@ pub struct ReplayOptions {
 pub struct ReplaySummary {
     /// States checked.
     pub states: usize,
-    /// States in collision.
+    /// States in collision (or failed closed).
     pub in_collision: usize,
     /// Deepest contact: (state index from 1, link, object, depth).
     pub deepest: Option<(usize, String, String, f64)>,
     /// Messages skipped, by cause.
-    pub skipped: BTreeMap<String, usize>,
+    pub skipped: BTreeMap<SkipCause, u64>,
+    /// `robot_description` messages applied, and refused.
+    pub descriptions: (usize, usize),
     /// Wall time of the replay loop (seconds), reading and writing included.
     pub seconds: f64,
     /// The fault that ended the bag early, if any (reports before it are kept).
@@ -69,10 +68,13 @@ impl std::fmt::Display for ReplaySummary {
         }
         let per = if self.states > 0 { self.seconds / self.states as f64 * 1e6 } else { 0.0 };
         writeln!(f, "time: {:.3} s, {per:.2} us per state ({:.0} states/s)", self.seconds, self.states as f64 / self.seconds.max(1e-12))?;
-        let total: usize = self.skipped.values().sum();
+        if self.descriptions != (0, 0) {
+            writeln!(f, "robot descriptions: {} applied, {} refused", self.descriptions.0, self.descriptions.1)?;
+        }
+        let total: u64 = self.skipped.values().sum();
         write!(f, "skipped messages: {total}")?;
         for (cause, n) in &self.skipped {
-            write!(f, "\n  {n} x {cause}")?;
+            write!(f, "\n  {n} x {}", cause.key())?;
         }
         if let Some(e) = &self.bag_error {
             write!(f, "\nbag error: {e}")?;
@@ -81,59 +83,64 @@ impl std::fmt::Display for ReplaySummary {
     }
 }
 
-fn bump(skipped: &mut BTreeMap<String, usize>, cause: String) -> bool {
-    let n = skipped.entry(cause).or_insert(0);
-    *n += 1;
-    *n == 1
+/// Warns about the first message of each kind of trouble only: a bag of a million bad messages
+/// must not print a million lines (the summary counts them all).
+#[derive(Default)]
+struct FirstWarnings {
+    seen: HashSet<String>,
+}
+
+impl FirstWarnings {
+    fn warn(&mut self, kind: &str, message: impl FnOnce() -> String) {
+        if self.seen.insert(kind.to_owned()) {
+            eprintln!("thickness_collision: warning: {} (further ones are counted, not printed)", message());
+        }
+    }
+}
+
+/// Where the checked states go.
+struct Outputs {
+    jsonl: Option<std::io::BufWriter<std::fs::File>>,
+    bag: Option<BagWriter>,
 }
 
 /// Replays a bag. Reports before a corrupt tail are kept; the fault is in the summary and makes
 /// the result an error after the outputs are written.
 pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, opts: &ReplayOptions) -> Result<ReplaySummary> {
+    let mut params = params;
+    if let Some(p) = opts.pose_source {
+        params.pose_source = p;
+    }
+    if let Some(p) = &opts.frame_prefix {
+        params.frame_prefix = p.clone();
+    }
+    let pose_source = params.pose_source;
     let bag = open_bag(&opts.bag)?;
-    let topic = opts.topic.clone().unwrap_or_else(|| match opts.pose_source {
+    let topic = opts.topic.clone().unwrap_or_else(|| match pose_source {
         PoseSource::JointStates => "/joint_states".into(),
         PoseSource::Tf => "/tf".into(),
     });
-    if !bag.topics.iter().any(|(t, _)| *t == topic) {
-        let have: Vec<&str> = bag.topics.iter().map(|(t, _)| t.as_str()).collect();
-        if let Some(e) = bag.error {
-            return Err(anyhow::Error::new(e).context(format!("topic {topic} not found before the bag's fault")));
-        }
+    if !bag.topics().iter().any(|(t, _)| *t == topic) {
+        let have: Vec<&str> = bag.topics().iter().map(|(t, _)| t.as_str()).collect();
         bail!("topic {topic} is not in bag {} (it has: {})", opts.bag.display(), have.join(", "));
     }
+    // Both doors start with the robot the parameters name; a description in the bag replaces it
+    // at its log time, as it would replace it in the running node.
+    let mut pipeline = Pipeline::new(params, robot, environment)?;
 
-    // The robot from the bag's /robot_description when no file is given.
-    let description = if robot.is_none() && params.robot_description_file.is_empty() {
-        bag.messages.iter().find(|m| m.topic == "/robot_description").map(|m| decode_cdr::<StringMsg>(&m.data))
-    } else {
-        None
-    };
-    let checker = match description {
-        Some(Ok(d)) => Checker::from_description(params, &d.data, &format!("/robot_description in {}", opts.bag.display()), environment)?,
-        Some(Err(e)) => return Err(anyhow::Error::new(e).context(format!("/robot_description in {}", opts.bag.display()))),
-        None => Checker::from_params(params, robot, environment)?,
-    };
-    let world = checker.params.world_frame.clone();
-
-    let t0 = bag.messages.first().map_or(0, |m| m.log_time);
-    let window = |m: &BagMessage| {
-        let s = (m.log_time - t0) as f64 * 1e-9;
-        opts.start.map_or(true, |a| s >= a) && opts.end.map_or(true, |b| s <= b)
-    };
-    let inputs: Vec<&BagMessage> = bag.messages.iter().filter(|m| (m.topic == topic || (opts.pose_source == PoseSource::Tf && m.topic == "/tf_static")) && window(m)).collect();
-
-    let mut jsonl = match &opts.jsonl {
-        Some(p) => Some(std::io::BufWriter::new(std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?)),
-        None => None,
-    };
-    let mut out_bag = match &opts.out_dir {
-        Some(d) => Some(BagWriter::create(d, "/collisions")?),
-        None => None,
+    let mut out = Outputs {
+        jsonl: match &opts.jsonl {
+            Some(p) => Some(std::io::BufWriter::new(std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?)),
+            None => None,
+        },
+        bag: match &opts.out_dir {
+            Some(d) => Some(BagWriter::create(d, "/collisions")?),
+            None => None,
+        },
     };
     let bar = if opts.progress && std::io::stderr().is_terminal() {
-        let b = indicatif::ProgressBar::new(inputs.len() as u64);
-        b.set_style(indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} states {per_sec} {eta}").unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()));
+        let b = indicatif::ProgressBar::new_spinner();
+        b.set_style(indicatif::ProgressStyle::with_template("{spinner} {pos} messages {per_sec}").unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()));
         Some(b)
     } else {
         None
@@ -141,97 +148,122 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
 
     let started = Instant::now();
     let mut summary = ReplaySummary::default();
-    let mut memory = JointMemory::new(&checker.robot);
-    let mut tf = TfTree::default();
-    let robot_links: Vec<String> = checker.targets.iter().map(|t| t.name.clone()).collect();
-    for (k, m) in inputs.iter().enumerate() {
-        if let Some(b) = &bar {
-            if k % 1024 == 0 {
-                b.set_position(k as u64);
-            }
-        }
-        let (report, stamp): (StateReport, Time) = match opts.pose_source {
-            PoseSource::JointStates => {
-                let js = match decode_cdr::<JointState>(&m.data) {
-                    Ok(js) => js,
-                    Err(e) => {
-                        if bump(&mut summary.skipped, format!("undecodable message on {topic}")) {
-                            eprintln!("thickness_collision: warning: message at {} ns on {topic} does not decode: {e}", m.log_time);
-                        }
-                        continue;
-                    }
-                };
-                match checker.check_joints(&js.name, &js.position, &mut memory, false) {
-                    Ok((r, unknown)) => {
-                        for u in unknown {
-                            if memory.first_unknown(&u) {
-                                eprintln!("thickness_collision: warning: '{u}' is not a joint of the robot model; ignored (warned once)");
-                            }
-                        }
-                        (r, js.header.stamp)
-                    }
-                    Err(e) => {
-                        if bump(&mut summary.skipped, format!("rejected state: {e}")) {
-                            eprintln!("thickness_collision: warning: state at {} ns rejected: {e}", m.log_time);
-                        }
-                        continue;
-                    }
-                }
-            }
-            PoseSource::Tf => {
-                let msg = match decode_cdr::<TfMessage>(&m.data) {
-                    Ok(msg) => msg,
-                    Err(e) => {
-                        if bump(&mut summary.skipped, format!("undecodable message on {}", m.topic)) {
-                            eprintln!("thickness_collision: warning: message at {} ns on {} does not decode: {e}", m.log_time, m.topic);
-                        }
-                        continue;
-                    }
-                };
-                for bad in tf.update(&msg) {
-                    let _ = bump(&mut summary.skipped, format!("non-finite transform for {bad}"));
-                }
-                if m.topic == "/tf_static" {
-                    continue;
-                }
-                let poses: Vec<(String, crate::math::Pose)> = robot_links.iter().filter_map(|l| tf.world_pose(l, &world).map(|p| (l.clone(), p))).collect();
-                let stamp = msg.transforms.iter().map(|t| t.header.stamp).max().unwrap_or_default();
-                match checker.check_transforms(&poses) {
-                    Ok(r) => (r, stamp),
-                    Err(e) => {
-                        let _ = bump(&mut summary.skipped, format!("rejected state: {e}"));
-                        continue;
-                    }
-                }
+    let mut warnings = FirstWarnings::default();
+    let mut t0 = None;
+    let mut read = 0u64;
+    for item in bag {
+        let m = match item {
+            Ok(m) => m,
+            Err(e) => {
+                summary.bag_error = Some(e.to_string());
+                break;
             }
         };
-        summary.states += 1;
-        if report.in_collision {
-            summary.in_collision += 1;
-        }
-        for c in &report.contacts {
-            if summary.deepest.as_ref().map_or(true, |d| c.depth > d.3) {
-                summary.deepest = Some((summary.states, c.link_name.clone(), c.object_name.clone(), c.depth));
+        read += 1;
+        if let Some(b) = &bar {
+            if read % 1024 == 0 {
+                b.set_position(read);
             }
         }
-        if let Some(w) = jsonl.as_mut() {
-            serde_json::to_writer(&mut *w, &report)?;
-            w.write_all(b"\n")?;
+        let t0 = *t0.get_or_insert(m.log_time);
+        let seconds = (m.log_time - t0) as f64 * 1e-9;
+        let in_window = opts.start.map_or(true, |a| seconds >= a) && opts.end.map_or(true, |b| seconds <= b);
+        let state = if m.topic == DESCRIPTION_TOPIC {
+            apply_description(&mut pipeline, &m, &opts.bag, &mut summary, &mut warnings);
+            continue;
+        } else if pose_source == PoseSource::Tf && m.topic == "/tf_static" {
+            match decode::<TfMessage>(&mut pipeline, &m, &mut warnings) {
+                Some(msg) => pipeline.tf_static(&msg).map(|()| None),
+                None => continue,
+            }
+        } else if m.topic != topic || !in_window {
+            continue;
+        } else {
+            match pose_source {
+                PoseSource::JointStates => match decode::<JointState>(&mut pipeline, &m, &mut warnings) {
+                    Some(msg) => pipeline.joint_state(&msg).map(Some),
+                    None => continue,
+                },
+                PoseSource::Tf => match decode::<TfMessage>(&mut pipeline, &m, &mut warnings) {
+                    Some(msg) => pipeline.tf(&msg).map(Some),
+                    None => continue,
+                },
+            }
+        };
+        for w in pipeline.take_warnings() {
+            eprintln!("thickness_collision: warning: {w}");
         }
-        if let Some(b) = out_bag.as_mut() {
-            b.write(&CollisionReport::from_state(&report, Header { stamp, frame_id: world.clone() }), m.log_time)?;
+        match state {
+            Ok(Some(state)) => {
+                let checked = pipeline.check(&state);
+                record(&mut summary, &checked);
+                write_outputs(&mut out, &checked, &pipeline.params().world_frame, m.log_time)?;
+            }
+            Ok(None) => {}
+            Err(Skip { cause, message }) => warnings.warn(cause.key(), || format!("message at log time {} ns skipped ({}): {message}", m.log_time, cause.key())),
         }
     }
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    if let Some(mut w) = jsonl {
+    if let Some(mut w) = out.jsonl {
         w.flush()?;
     }
-    if let Some(b) = out_bag {
+    if let Some(b) = out.bag {
         let _ = b.finish()?;
     }
     summary.seconds = started.elapsed().as_secs_f64();
-    summary.bag_error = bag.error.map(|e| e.to_string());
+    summary.skipped = pipeline.skipped().clone();
     Ok(summary)
+}
+
+/// Decodes a message, or counts it as undecodable.
+fn decode<T: serde::de::DeserializeOwned>(pipeline: &mut Pipeline, m: &BagMessage, warnings: &mut FirstWarnings) -> Option<T> {
+    match decode_cdr::<T>(&m.data) {
+        Ok(msg) => Some(msg),
+        Err(e) => {
+            pipeline.count_skip(SkipCause::Undecodable, 1);
+            warnings.warn(SkipCause::Undecodable.key(), || format!("message at log time {} ns on {} does not decode: {e}", m.log_time, m.topic));
+            None
+        }
+    }
+}
+
+fn apply_description(pipeline: &mut Pipeline, m: &BagMessage, bag: &Path, summary: &mut ReplaySummary, warnings: &mut FirstWarnings) {
+    let source = format!("{DESCRIPTION_TOPIC} in {} at log time {} ns", bag.display(), m.log_time);
+    let result = decode_cdr::<StringMsg>(&m.data).map_err(|e| e.to_string()).and_then(|d| pipeline.set_robot_description(&d.data, &source).map_err(|e| e.to_string()));
+    match result {
+        Ok(()) => {
+            summary.descriptions.0 += 1;
+            let s = pipeline.checker().summary();
+            eprintln!("thickness_collision: robot from {source}: {} links, {} checked", s.robot_links, s.checked_links);
+        }
+        Err(e) => {
+            summary.descriptions.1 += 1;
+            warnings.warn("description", || format!("{source} refused, keeping the current robot: {e}"));
+        }
+    }
+}
+
+fn record(summary: &mut ReplaySummary, checked: &CheckedState) {
+    summary.states += 1;
+    if checked.report.in_collision {
+        summary.in_collision += 1;
+    }
+    for c in &checked.report.contacts {
+        if summary.deepest.as_ref().map_or(true, |d| c.depth > d.3) {
+            summary.deepest = Some((summary.states, c.link_name.clone(), c.object_name.clone(), c.depth));
+        }
+    }
+}
+
+fn write_outputs(out: &mut Outputs, checked: &CheckedState, frame: &str, log_time: i64) -> Result<()> {
+    if let Some(w) = out.jsonl.as_mut() {
+        w.write_all(checked.json().as_bytes())?;
+        w.write_all(b"\n")?;
+    }
+    if let Some(b) = out.bag.as_mut() {
+        b.write(&checked.message(frame), log_time)?;
+    }
+    Ok(())
 }

@@ -1,6 +1,8 @@
 //! RViz markers of the cells and the contacts, and the `/diagnostics` status.
 
 use crate::checker::{Checker, StateReport};
+use crate::pipeline::SkipCause;
+use std::collections::BTreeMap;
 use crate::msgs::{ColorRgba, DiagnosticArray, DiagnosticStatus, DurationMsg, Header, KeyValue, Marker, MarkerArray, Point, Quaternion, Time, Vector3};
 
 const TRIANGLE_LIST: i32 = 11;
@@ -15,7 +17,7 @@ fn point(v: crate::math::Vector) -> Point {
 pub fn cell_markers(checker: &Checker, max_cells: usize, frame: &str, stamp: Time) -> MarkerArray {
     let mut markers = Vec::new();
     let mut left = max_cells;
-    for (id, object) in checker.scene.objects().iter().enumerate() {
+    for (id, object) in checker.scene().objects().iter().enumerate() {
         let Some(area) = object.area() else { continue };
         let mut points = Vec::new();
         for cell in area.cells.iter().take(left) {
@@ -56,22 +58,20 @@ pub fn contact_markers(report: &StateReport, frame: &str, stamp: Time) -> Marker
             scale: Vector3 { x: 0.02, y: 0.02, z: 0.02 },
             color: ColorRgba { r: 1.0, g: 0.0, b: 0.0, a: 1.0 },
             lifetime: DurationMsg { sec: 0, nanosec: 500_000_000 },
-            points: report.contacts.iter().map(|c| Point { x: c.position[0], y: c.position[1], z: c.position[2] }).collect(),
+            points: report.contacts.iter().filter_map(|c| c.position).map(|p| Point { x: p[0], y: p[1], z: p[2] }).collect(),
             ..Default::default()
         }],
     }
 }
 
-/// Counters the node keeps for `/diagnostics`.
+/// Counters the node keeps for `/diagnostics` (skips are counted by the pipeline).
 #[derive(Default)]
 pub struct NodeStats {
-    /// States received since start.
+    /// Input messages received since start (states, `/tf`).
     pub received: u64,
     /// States checked since start.
     pub checked: u64,
-    /// States skipped as stale since start.
-    pub skipped: u64,
-    /// Sum and maximum of check times since the last status (seconds).
+    /// Sum of check times since the last status (seconds).
     pub check_sum: f64,
     /// Maximum check time since the last status.
     pub check_max: f64,
@@ -91,24 +91,31 @@ impl NodeStats {
     }
 }
 
-/// The node's status: input rate, skips and check time over the last `seconds`.
-pub fn diagnostics(node: &str, stats: &mut NodeStats, seconds: f64, stamp: Time) -> DiagnosticArray {
+/// The node's status: input rate, skips by cause and check time over the last `seconds`. Any
+/// skip other than a stale one (a bad or foreign message) raises the level to WARN.
+pub fn diagnostics(node: &str, stats: &mut NodeStats, skipped: &BTreeMap<SkipCause, u64>, seconds: f64, stamp: Time) -> DiagnosticArray {
     let rate = (stats.received - stats.last_received) as f64 / seconds.max(1e-9);
     let mean = if stats.window_checks > 0 { stats.check_sum / stats.window_checks as f64 } else { 0.0 };
+    let total: u64 = skipped.values().sum();
+    let bad: u64 = skipped.iter().filter(|(c, _)| **c != SkipCause::Stale).map(|(_, n)| n).sum();
     let kv = |k: &str, v: String| KeyValue { key: k.into(), value: v };
+    let mut values = vec![
+        kv("input_rate_hz", format!("{rate:.3}")),
+        kv("states_received", stats.received.to_string()),
+        kv("states_checked", stats.checked.to_string()),
+        kv("states_skipped", total.to_string()),
+        kv("check_seconds_mean", format!("{mean:.9}")),
+        kv("check_seconds_max", format!("{:.9}", stats.check_max)),
+    ];
+    for cause in SkipCause::ALL {
+        values.push(kv(&format!("skipped_{}", cause.key()), skipped.get(&cause).copied().unwrap_or(0).to_string()));
+    }
     let status = DiagnosticStatus {
-        level: 0,
+        level: if bad > 0 { 1 } else { 0 },
         name: format!("{node}: collision checks"),
-        message: format!("{rate:.1} states/s, {} skipped", stats.skipped),
+        message: format!("{rate:.1} states/s, {total} skipped ({bad} bad or foreign)"),
         hardware_id: String::new(),
-        values: vec![
-            kv("input_rate_hz", format!("{rate:.3}")),
-            kv("states_received", stats.received.to_string()),
-            kv("states_checked", stats.checked.to_string()),
-            kv("states_skipped", stats.skipped.to_string()),
-            kv("check_seconds_mean", format!("{mean:.9}")),
-            kv("check_seconds_max", format!("{:.9}", stats.check_max)),
-        ],
+        values,
     };
     stats.last_received = stats.received;
     stats.check_sum = 0.0;

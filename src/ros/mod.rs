@@ -8,6 +8,7 @@
 mod markers;
 mod msg_impls;
 mod node_run;
+mod param_values;
 mod ros_args;
 
 pub use self::node_run::{run, RunOptions};

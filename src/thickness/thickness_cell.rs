@@ -4,7 +4,7 @@ use crate::math::{Real, Vector};
 use serde::{Deserialize, Serialize};
 
 /// Where the volume of a thin surface goes, relative to the front normal `n` of each face.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Side {
     /// Along `-n`, behind the visible face (the default).
@@ -23,6 +23,19 @@ impl Side {
             Side::Back => "back",
             Side::Front => "front",
             Side::Both => "both",
+        }
+    }
+}
+
+impl std::str::FromStr for Side {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Side, String> {
+        match s {
+            "back" => Ok(Side::Back),
+            "front" => Ok(Side::Front),
+            "both" => Ok(Side::Both),
+            _ => Err(format!("'{s}' is not a side (back, front or both)")),
         }
     }
 }

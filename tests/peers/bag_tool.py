@@ -97,5 +97,77 @@ def parse(req):
     return out
 
 
+def write_many(req):
+    """Many joint states, generated here from a seed (JSON for a million states would be slow):
+    uniform in [lo, hi] per joint. The CDR is packed by hand (the names never change, so only the
+    stamp and the positions do) and checked once against rosbags' own serializer; the bag is written
+    by rosbags' Writer. The joints: "urdf" (its moving joints) or "names", "lo", "hi". Optional
+    "compression": "zstd" (MCAP chunks)."""
+    import struct
+    from rosbags.rosbag2 import CompressionFormat, CompressionMode
+    store = get_typestore(Stores.ROS2_JAZZY)
+    Header = store.types["std_msgs/msg/Header"]
+    JointState = store.types["sensor_msgs/msg/JointState"]
+    if "urdf" in req:  # the moving joints of a URDF, limits clamped to [-3, 3] (continuous: that range)
+        import xml.etree.ElementTree as ET
+        names, lo, hi = [], [], []
+        for j in ET.parse(req["urdf"]).getroot().iter("joint"):
+            if j.get("type") in ("revolute", "continuous", "prismatic"):
+                lim = j.find("limit")
+                a, b = (-3.0, 3.0) if lim is None or j.get("type") == "continuous" else (float(lim.get("lower", "-3")), float(lim.get("upper", "3")))
+                names.append(j.get("name"))
+                lo.append(max(a, -3.0))
+                hi.append(min(b, 3.0))
+    else:
+        names, lo, hi = req["names"], req["lo"], req["hi"]
+    lo, hi = np.array(lo, dtype=np.float64), np.array(hi, dtype=np.float64)
+    n, t0, dt = int(req["count"]), int(req["t0"]), int(req.get("dt", 10_000_000))
+    rng = np.random.default_rng(int(req.get("seed", 1)))
+
+    def align(buf, k):  # CDR alignment, counted after the 4-byte encapsulation header
+        buf += b"\0" * ((-(len(buf) - 4)) % k)
+
+    head = bytearray(b"\x00\x01\x00\x00")
+    head += b"\0" * 8  # stamp: sec, nanosec
+    head += struct.pack("<I", 1) + b"\0"  # frame_id ""
+    align(head, 4)
+    head += struct.pack("<I", len(names))
+    for name in names:
+        align(head, 4)
+        b = name.encode() + b"\0"
+        head += struct.pack("<I", len(b)) + b
+    align(head, 4)
+    head += struct.pack("<I", len(names))
+    align(head, 8)
+    tail = bytearray()
+    for _ in range(2):  # velocity, effort: empty
+        pad = (-(len(head) + len(names) * 8 + len(tail) - 4)) % 4
+        tail += b"\0" * pad + struct.pack("<I", 0)
+
+    def cdr(k, pos):
+        ns = t0 + k * dt
+        head[4:12] = struct.pack("<iI", ns // 1_000_000_000, ns % 1_000_000_000)
+        return bytes(head) + pos.tobytes() + bytes(tail)
+
+    plugin = StoragePlugin.MCAP if req["storage"] == "mcap" else StoragePlugin.SQLITE3
+    w = Writer(req["path"], version=8, storage_plugin=plugin)
+    if req.get("compression") == "zstd":
+        w.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+    with w:
+        js = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=store)
+        block = 65536
+        for start in range(0, n, block):
+            pos = lo + (hi - lo) * rng.random((min(block, n - start), len(names)))
+            if start == 0:
+                ns = t0
+                ref = store.serialize_cdr(JointState(header=Header(stamp=time(ns, store), frame_id=""), name=names, position=pos[0],
+                                                     velocity=np.array([], dtype=np.float64), effort=np.array([], dtype=np.float64)), js.msgtype)
+                assert bytes(ref) == cdr(0, pos[0]), "hand-packed CDR differs from rosbags'"
+            for i in range(len(pos)):
+                k = start + i
+                w.write(js, t0 + k * dt, cdr(k, pos[i]))
+    return {"ok": True, "count": n}
+
+
 req = json.load(sys.stdin)
-json.dump({"write": write, "read": read, "parse": parse}[req["op"]](req), sys.stdout)
+json.dump({"write": write, "read": read, "parse": parse, "write_many": write_many}[req["op"]](req), sys.stdout)

@@ -68,7 +68,7 @@ def report_json(r):
     return {"in_collision": bool(r.in_collision), "stamp": r.header.stamp.sec * 1_000_000_000 + r.header.stamp.nanosec, "frame_id": r.header.frame_id,
             "contacts": [{"link_name": c.link_name, "object_name": c.object_name, "triangle": int(c.triangle), "depth": c.depth,
                           "position": [c.position.x, c.position.y, c.position.z], "normal": [c.normal.x, c.normal.y, c.normal.z]} for c in r.contacts],
-            "check_seconds": r.check_seconds}
+            "check_seconds": r.check_seconds, "error": r.error}
 
 
 req = json.load(sys.stdin)

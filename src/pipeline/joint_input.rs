@@ -1,0 +1,51 @@
+//! Joint states to positions of every joint: validation, merging of partial messages and the
+//! `missing_joint` rule, the same for the node, replay and `check --states`.
+
+use crate::checker::StateError;
+use crate::model::{MissingJoint, RobotModel};
+
+/// The positions received so far (merged across messages under `last` and `reject`).
+#[derive(Clone, Debug)]
+pub(crate) struct JointInput {
+    received: Vec<Option<f64>>,
+}
+
+impl JointInput {
+    /// Nothing received yet for any joint of `robot`.
+    pub fn new(robot: &RobotModel) -> JointInput {
+        JointInput { received: vec![None; robot.joints.len()] }
+    }
+
+    /// One message: the position of every joint, or why the message gives no state. A bad message
+    /// changes nothing (it is not merged). Names that are not joints of `robot` are ignored (other
+    /// robots share the topic) and pushed to `unknown`.
+    pub fn ingest(&mut self, robot: &RobotModel, missing: MissingJoint, names: &[String], positions: &[f64], unknown: &mut Vec<String>) -> Result<Vec<f64>, StateError> {
+        if names.len() != positions.len() {
+            return Err(StateError::Lengths { names: names.len(), positions: positions.len() });
+        }
+        let mut given: Vec<(usize, f64)> = Vec::with_capacity(names.len().min(robot.joints.len()));
+        for (name, &value) in names.iter().zip(positions) {
+            match robot.joint(name) {
+                Some(_) if !value.is_finite() => return Err(StateError::NonFinite { joint: name.clone(), value }),
+                Some(j) => given.push((j, value)),
+                None => unknown.push(name.clone()),
+            }
+        }
+        if missing == MissingJoint::Zero {
+            self.received.iter_mut().for_each(|v| *v = None);
+        }
+        for (j, value) in given {
+            self.received[j] = Some(value);
+        }
+        robot
+            .joints
+            .iter()
+            .zip(&self.received)
+            .map(|(joint, v)| match v {
+                Some(v) => Ok(*v),
+                None if joint.is_actuated() && missing == MissingJoint::Reject => Err(StateError::Missing(joint.name.clone())),
+                None => Ok(0.0),
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,22 @@
+//! Messages to checked robot states: the one pipeline the node, replay and `check` share.
+//!
+//! Each front door turns its input into messages (`sensor_msgs/JointState`, `tf2_msgs/TFMessage`,
+//! `robot_description`) and hands them to a [`Pipeline`] in arrival order; the pipeline validates
+//! them, merges partial joint states (`missing_joint`), composes `/tf` with `frame_prefix` up to
+//! `world_frame`, checks the resulting robot state and gives back a [`CheckedState`] with the
+//! input's stamp. A message that gives no state is a [`Skip`] with a counted [`SkipCause`]:
+//! nothing that was not checked is ever reported, and a state that cannot be checked where an
+//! answer is owed (a service slot, a `check` line) fails closed (`in_collision` and `error`).
+
+mod joint_input;
+mod report_adapter;
+mod skip;
+mod state_pipeline;
+mod tf_tree;
+
+pub use self::report_adapter::{report_message, CheckedState};
+pub use self::skip::{Skip, SkipCause};
+pub use self::state_pipeline::{Pipeline, RobotState};
+
+#[cfg(test)]
+mod pipeline_tests;

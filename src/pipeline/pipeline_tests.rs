@@ -1,0 +1,198 @@
+//! The pipeline without DDS: merging, `missing_joint`, TF with a prefix, run-time parameters.
+
+use super::{Pipeline, SkipCause};
+use crate::checker::{Checker, StateReport};
+use crate::math::pose_from_isometry;
+use crate::model::{MissingJoint, Params};
+use crate::msgs::{Header, JointState, Quaternion, TfMessage, Time, Transform, TransformStamped, Vector3};
+use nalgebra::Isometry3;
+
+const ARM: [&str; 7] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
+
+fn js(names: &[&str], positions: &[f64], ns: i64) -> JointState {
+    JointState { header: Header { stamp: Time::from_nanos(ns), frame_id: String::new() }, name: names.iter().map(|s| s.to_string()).collect(), position: positions.to_vec(), ..Default::default() }
+}
+
+fn pipeline(params: Params) -> Pipeline {
+    Pipeline::new(params, None, None).unwrap()
+}
+
+/// A colliding pose of the bundled arm (the forearm reaches into the guard) and a clear one.
+fn poses() -> ([f64; 7], [f64; 7]) {
+    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let names: Vec<String> = ARM.iter().map(|s| s.to_string()).collect();
+    let mut colliding = None;
+    let mut clear = None;
+    for k in 0..200 {
+        let x = k as f64;
+        let q = [(0.37 * x).sin() * 1.5, 0.3 + (0.23 * x).cos() * 1.1, (0.11 * x).sin() * 1.6, 0.2 * x % 3.0, (0.5 * x).cos() * 1.5, 0.1 * x, 0.02];
+        let r = checker.check_joints(&names, &q).unwrap();
+        if r.in_collision && colliding.is_none() {
+            colliding = Some(q);
+        }
+        if !r.in_collision && clear.is_none() {
+            clear = Some(q);
+        }
+    }
+    (colliding.unwrap(), clear.unwrap())
+}
+
+#[test]
+fn partial_states_from_two_publishers_merge_under_last() {
+    let (hit, _) = poses();
+    let mut p = pipeline(Params::default());
+    assert_eq!(p.params().missing_joint, MissingJoint::Last, "the default merges, as robot_state_publisher does");
+    // The arm publisher, then the gripper publisher: the second state holds both.
+    let a = p.joint_state(&js(&ARM[..6], &hit[..6], 1)).unwrap();
+    let b = p.joint_state(&js(&ARM[6..], &hit[6..], 2)).unwrap();
+    let whole = pipeline(Params::default()).joint_state(&js(&ARM, &hit, 2)).unwrap();
+    assert_eq!(b, whole, "merged partial states equal the whole state");
+    assert_ne!(a, b, "the gripper's position arrived with the second message");
+    assert!(p.check(&b).report.in_collision);
+    assert_eq!(p.check(&b).stamp, Time::from_nanos(2));
+}
+
+#[test]
+fn zero_checks_each_message_alone_and_reject_waits_for_every_joint() {
+    let (hit, _) = poses();
+    let zero = Params { missing_joint: MissingJoint::Zero, ..Params::default() };
+    let mut p = pipeline(zero);
+    let _ = p.joint_state(&js(&ARM, &hit, 1)).unwrap();
+    let alone = p.joint_state(&js(&ARM[6..], &hit[6..], 2)).unwrap();
+    let fresh = pipeline(Params { missing_joint: MissingJoint::Zero, ..Params::default() }).joint_state(&js(&ARM[6..], &hit[6..], 2)).unwrap();
+    assert_eq!(alone, fresh, "under zero a message does not inherit earlier ones");
+
+    let mut p = pipeline(Params { missing_joint: MissingJoint::Reject, ..Params::default() });
+    let skip = p.joint_state(&js(&ARM[..6], &hit[..6], 1)).unwrap_err();
+    assert_eq!(skip.cause, SkipCause::MissingJoint);
+    assert!(skip.message.contains("finger_left_joint"), "{}", skip.message);
+    assert!(p.joint_state(&js(&ARM[6..], &hit[6..], 2)).is_ok(), "complete once the gripper arrived");
+    assert_eq!(p.skipped().get(&SkipCause::MissingJoint), Some(&1));
+}
+
+#[test]
+fn bad_messages_are_skipped_counted_and_not_merged() {
+    let (hit, clear) = poses();
+    let mut p = pipeline(Params::default());
+    let good = p.joint_state(&js(&ARM, &clear, 1)).unwrap();
+    let nan = p.joint_state(&js(&ARM[..1], &[f64::NAN], 2)).unwrap_err();
+    assert_eq!(nan.cause, SkipCause::NonFinite);
+    let lengths = p.joint_state(&js(&ARM[..2], &hit[..1], 3)).unwrap_err();
+    assert_eq!(lengths.cause, SkipCause::Lengths);
+    // A message with a bad position changes nothing: the next partial state merges onto `good`.
+    let after = p.joint_state(&js(&[], &[], 4)).unwrap();
+    let report = |s| StateReport { check_seconds: 0.0, ..p.check(s).report };
+    assert_eq!(report(&after), report(&good));
+    // Unknown names: ignored, warned once each; a NaN on another robot's joint is not ours.
+    let other = p.joint_state(&js(&["other_robot_joint", ARM[0]], &[f64::NAN, clear[0]], 5));
+    assert!(other.is_ok());
+    let _ = p.joint_state(&js(&["other_robot_joint"], &[1.0], 6)).unwrap();
+    let warnings = p.take_warnings();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("other_robot_joint"));
+    assert_eq!(p.skipped().values().sum::<u64>(), 2);
+}
+
+fn tf_message(prefix: &str, world: &str, checker: &Checker, q: &[f64], ns: i64) -> TfMessage {
+    let mut full = vec![0.0; checker.robot().joints.len()];
+    for (n, v) in ARM.iter().zip(q) {
+        full[checker.robot().joint(n).unwrap()] = *v;
+    }
+    let poses = checker.robot().forward_kinematics(&full, &Isometry3::identity()).unwrap();
+    let transforms = checker
+        .targets()
+        .iter()
+        .map(|t| {
+            let p = pose_from_isometry(&poses[t.link]);
+            TransformStamped {
+                header: Header { stamp: Time::from_nanos(ns), frame_id: world.into() },
+                child_frame_id: format!("{prefix}{}", t.name),
+                transform: Transform {
+                    translation: Vector3 { x: p.translation.x, y: p.translation.y, z: p.translation.z },
+                    rotation: Quaternion { x: p.rotation.x, y: p.rotation.y, z: p.rotation.z, w: p.rotation.w },
+                },
+            }
+        })
+        .collect();
+    TfMessage { transforms }
+}
+
+#[test]
+fn tf_with_a_prefix_gives_the_joint_state_answer_and_foreign_frames_are_skipped() {
+    let (hit, _) = poses();
+    let params = Params { frame_prefix: "robot1/".into(), ..Params::default() };
+    let mut p = pipeline(params);
+    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let by_joints = pipeline(Params::default()).check(&pipeline(Params::default()).joint_state(&js(&ARM, &hit, 7)).unwrap());
+    let state = p.tf(&tf_message("robot1/", "world", &checker, &hit, 7)).unwrap();
+    let by_tf = p.check(&state);
+    assert_eq!(by_tf.stamp, Time::from_nanos(7));
+    assert!(by_tf.report.in_collision);
+    assert_eq!(by_tf.report.contacts.len(), by_joints.report.contacts.len());
+    for (a, b) in by_tf.report.contacts.iter().zip(&by_joints.report.contacts) {
+        assert_eq!(a.link_name, b.link_name);
+        assert!((a.depth - b.depth).abs() < 1e-9);
+    }
+    // Another robot's frames (no prefix): not a state of this robot.
+    let skip = p.tf(&tf_message("robot2/", "world", &checker, &hit, 8)).unwrap_err();
+    assert_eq!(skip.cause, SkipCause::NotOurRobot);
+    // A robot whose frames hang off a frame that does not reach the world yet.
+    let mut q = pipeline(Params { frame_prefix: "robot1/".into(), ..Params::default() });
+    let skip = q.tf(&tf_message("robot1/", "robot1/odom", &checker, &hit, 9)).unwrap_err();
+    assert_eq!(skip.cause, SkipCause::Unreachable);
+    // /tf_static closes the chain; the next /tf is a state.
+    let odom = TfMessage {
+        transforms: vec![TransformStamped { header: Header { stamp: Time::default(), frame_id: "world".into() }, child_frame_id: "robot1/odom".into(), transform: Transform::default() }],
+    };
+    q.tf_static(&odom).unwrap();
+    assert!(q.tf(&tf_message("robot1/", "robot1/odom", &checker, &hit, 10)).is_ok());
+    // A non-finite transform: the whole message is refused.
+    let mut bad = tf_message("robot1/", "world", &checker, &hit, 11);
+    bad.transforms[0].transform.translation.x = f64::NAN;
+    assert_eq!(q.tf(&bad).unwrap_err().cause, SkipCause::BadTransform);
+}
+
+#[test]
+fn world_frame_set_at_run_time_is_used_by_tf_lookups_and_headers() {
+    let (hit, _) = poses();
+    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let mut p = pipeline(Params::default());
+    let in_map = tf_message("", "map", &checker, &hit, 1);
+    assert_eq!(p.tf(&in_map).unwrap_err().cause, SkipCause::Unreachable, "'map' is not the world yet");
+    let params = p.params().with_overrides(&[("world_frame".into(), "map".into())]).unwrap();
+    p.set_params(params).unwrap();
+    let state = p.tf(&in_map).unwrap();
+    let checked = p.check(&state);
+    assert_eq!(checked.message(&p.params().world_frame).header.frame_id, "map");
+    assert!(checked.report.in_collision);
+}
+
+#[test]
+fn a_parameter_rebuild_keeps_a_robot_received_as_description() {
+    let urdf = std::fs::read_to_string(crate::model::bundled_config_dir().join("example_workcell/robot.urdf")).unwrap();
+    let gripper = crate::model::bundled_config_dir().join("example_workcell/gripper.obj");
+    let urdf = urdf.replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", gripper.display())).replace("name=\"tc_arm\"", "name=\"from_topic\"");
+    let mut p = pipeline(Params::default());
+    p.set_robot_description(&urdf, "test").unwrap();
+    let thicker = p.params().with_overrides(&[("default_thickness".into(), "0.05".into())]).unwrap();
+    p.set_params(thicker).unwrap();
+    assert_eq!(p.checker().summary().robot_source, "test", "the robot keeps its source");
+    assert_eq!(p.params().default_thickness, 0.05);
+    assert!(p.set_robot_description("<robot name='broken'><link name='a'></robot>", "bad").is_err());
+    assert_eq!(p.checker().summary().robot_source, "test", "a bad description leaves the robot");
+}
+
+#[test]
+fn service_states_fail_closed_in_their_slots() {
+    let (hit, clear) = poses();
+    let p = pipeline(Params::default());
+    let mut unknown = js(&ARM, &clear, 3);
+    unknown.name[0] = "no_such_joint".into();
+    let reports = p.check_request(&[js(&ARM, &hit, 1), js(&ARM[..1], &[f64::NAN], 2), unknown, js(&ARM, &clear, 4)]);
+    assert_eq!(reports.len(), 4);
+    assert!(reports[0].in_collision && reports[0].error.is_empty());
+    assert!(reports[1].in_collision && reports[1].error.contains("non-finite"), "{}", reports[1].error);
+    assert!(reports[2].in_collision && reports[2].error.contains("no_such_joint"), "{}", reports[2].error);
+    assert!(!reports[3].in_collision && reports[3].error.is_empty());
+    assert_eq!(reports.iter().map(|r| r.header.stamp.as_nanos()).collect::<Vec<_>>(), vec![1, 2, 3, 4]);
+}

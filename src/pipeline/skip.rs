@@ -1,0 +1,62 @@
+//! Why an input message gave no checked state: one name per cause, counted the same way by the
+//! node (in `/diagnostics`), replay (in its summary) and `check`.
+
+/// A cause of a skipped message.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[non_exhaustive]
+pub enum SkipCause {
+    /// The payload does not decode as the topic's type.
+    Undecodable,
+    /// A joint state whose `name` and `position` differ in length.
+    Lengths,
+    /// A joint position that is NaN or infinite.
+    NonFinite,
+    /// An actuated joint never received, under `missing_joint: reject`.
+    MissingJoint,
+    /// A transform that is not finite or not a rotation, or a new frame past the frame limit.
+    BadTransform,
+    /// A `/tf` message that names none of the robot's frames (another robot's, a sensor's).
+    NotOurRobot,
+    /// A checked link whose frame does not reach `world_frame` yet.
+    Unreachable,
+    /// A state overtaken by a newer one before the node could check it (the node only).
+    Stale,
+}
+
+impl SkipCause {
+    /// Every cause, in the order reports list them.
+    pub const ALL: [SkipCause; 8] = [
+        SkipCause::Undecodable,
+        SkipCause::Lengths,
+        SkipCause::NonFinite,
+        SkipCause::MissingJoint,
+        SkipCause::BadTransform,
+        SkipCause::NotOurRobot,
+        SkipCause::Unreachable,
+        SkipCause::Stale,
+    ];
+
+    /// The name used in `/diagnostics` keys, summaries and logs.
+    pub fn key(self) -> &'static str {
+        match self {
+            SkipCause::Undecodable => "undecodable",
+            SkipCause::Lengths => "lengths",
+            SkipCause::NonFinite => "non_finite",
+            SkipCause::MissingJoint => "missing_joint",
+            SkipCause::BadTransform => "bad_transform",
+            SkipCause::NotOurRobot => "not_our_robot",
+            SkipCause::Unreachable => "unreachable",
+            SkipCause::Stale => "stale",
+        }
+    }
+}
+
+/// A message that gave no state: the cause (counted) and what was wrong (for the log, and the
+/// `error` of a fail-closed report).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Skip {
+    /// The cause.
+    pub cause: SkipCause,
+    /// What was wrong, naming the field and value.
+    pub message: String,
+}

@@ -1,0 +1,232 @@
+//! The one path from input messages to checked states. The node, replay and `check` hand it
+//! messages in arrival order and publish what it returns; it owns everything that decides an
+//! answer (the checker, merged joint states, the TF tree, the robot's source, skip counts), so the
+//! same messages give the same reports, stamps and skips through every door.
+
+use super::joint_input::JointInput;
+use super::report_adapter::CheckedState;
+use super::skip::{Skip, SkipCause};
+use super::tf_tree::{TfRejection, TfTree};
+use crate::checker::{Checker, CheckerError, StateError, StateReport};
+use crate::math::Pose;
+use crate::model::Params;
+use crate::msgs::{CollisionReport, JointState, TfMessage, Time};
+use std::collections::{BTreeMap, HashSet};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Unknown joint names remembered (to warn once each); past this, new ones are not warned
+/// about, so a flood of made-up names cannot grow memory.
+const MAX_UNKNOWN_NAMES: usize = 1024;
+
+/// Where the robot came from: it keeps its source when parameters change.
+#[derive(Clone, Debug)]
+enum RobotSource {
+    /// `--robot`, else the parameters' `robot_description_file`, else the bundled arm.
+    Files { robot: Option<PathBuf> },
+    /// A `robot_description` message (URDF text) and what to call it in errors.
+    Description { urdf: Arc<str>, source: String },
+}
+
+/// A robot state ready to check: positions of every joint, or world poses of the links.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotState {
+    /// The input's stamp.
+    pub stamp: Time,
+    pose: StatePose,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum StatePose {
+    Joints(Vec<f64>),
+    Links(Vec<Option<Pose>>),
+}
+
+/// Messages in, checked states out. See the module documentation.
+pub struct Pipeline {
+    checker: Arc<Checker>,
+    source: RobotSource,
+    environment: Option<PathBuf>,
+    joints: JointInput,
+    tf: TfTree,
+    skipped: BTreeMap<SkipCause, u64>,
+    unknown_names: HashSet<String>,
+    warnings: Vec<String>,
+}
+
+impl Pipeline {
+    /// The robot and environment the parameters name (or the overrides), with the bundled
+    /// example workcell as the default for both.
+    pub fn new(params: Params, robot: Option<&Path>, environment: Option<&Path>) -> Result<Pipeline, CheckerError> {
+        let checker = Checker::from_params(params, robot, environment)?;
+        Ok(Self::with_checker(checker, RobotSource::Files { robot: robot.map(Path::to_owned) }, environment.map(Path::to_owned)))
+    }
+
+    fn with_checker(checker: Checker, source: RobotSource, environment: Option<PathBuf>) -> Pipeline {
+        let joints = JointInput::new(checker.robot());
+        Pipeline {
+            checker: Arc::new(checker),
+            source,
+            environment,
+            joints,
+            tf: TfTree::default(),
+            skipped: BTreeMap::new(),
+            unknown_names: HashSet::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    /// The checker in force (shared: a batch on other threads keeps the one it started with).
+    pub fn checker(&self) -> &Arc<Checker> {
+        &self.checker
+    }
+
+    /// The parameters in force.
+    pub fn params(&self) -> &Params {
+        self.checker.params()
+    }
+
+    /// Messages skipped so far, by cause.
+    pub fn skipped(&self) -> &BTreeMap<SkipCause, u64> {
+        &self.skipped
+    }
+
+    /// Counts skipped messages the front door decided on (undecodable payloads, stale states).
+    pub fn count_skip(&mut self, cause: SkipCause, n: u64) {
+        if n > 0 {
+            *self.skipped.entry(cause).or_insert(0) += n;
+        }
+    }
+
+    /// Warnings that are not skips (an unknown joint name, once per name), oldest first.
+    pub fn take_warnings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.warnings)
+    }
+
+    fn skip(&mut self, cause: SkipCause, message: String) -> Skip {
+        self.count_skip(cause, 1);
+        Skip { cause, message }
+    }
+
+    /// A `sensor_msgs/JointState` from the stream: the state to check, or why there is none.
+    pub fn joint_state(&mut self, msg: &JointState) -> Result<RobotState, Skip> {
+        let mut unknown = Vec::new();
+        let missing = self.params().missing_joint;
+        let result = self.joints.ingest(self.checker.robot(), missing, &msg.name, &msg.position, &mut unknown);
+        for name in unknown {
+            if self.unknown_names.len() < MAX_UNKNOWN_NAMES && self.unknown_names.insert(name.clone()) {
+                self.warnings.push(format!("'{name}' is not a joint of the robot model; ignored (warned once)"));
+            }
+        }
+        match result {
+            Ok(q) => Ok(RobotState { stamp: msg.header.stamp, pose: StatePose::Joints(q) }),
+            Err(e) => {
+                let cause = match e {
+                    StateError::Lengths { .. } => SkipCause::Lengths,
+                    StateError::NonFinite { .. } => SkipCause::NonFinite,
+                    _ => SkipCause::MissingJoint,
+                };
+                Err(self.skip(cause, e.to_string()))
+            }
+        }
+    }
+
+    /// A `/tf_static` message: it only updates the TF tree.
+    pub fn tf_static(&mut self, msg: &TfMessage) -> Result<(), Skip> {
+        self.tf.update(msg).map_err(|r| self.tf_skip(r, "/tf_static"))
+    }
+
+    fn tf_skip(&mut self, r: TfRejection, topic: &str) -> Skip {
+        let message = match r {
+            TfRejection::NotRigid(f) => format!("{topic}: the transform of frame '{f}' is not a finite rigid transform"),
+            TfRejection::TooManyFrames(f) => format!("{topic}: new frame '{f}' would pass {} frames", TfTree::MAX_FRAMES),
+        };
+        self.skip(SkipCause::BadTransform, message)
+    }
+
+    /// A `/tf` message: the robot's link poses in `world_frame` after it, or why there is no
+    /// state. A message that names none of the robot's frames (with `frame_prefix`) updates the
+    /// tree but is not a state of this robot.
+    pub fn tf(&mut self, msg: &TfMessage) -> Result<RobotState, Skip> {
+        self.tf.update(msg).map_err(|r| self.tf_skip(r, "/tf"))?;
+        let checker = self.checker.clone();
+        let (prefix, world) = (&checker.params().frame_prefix, &checker.params().world_frame);
+        let robot = checker.robot();
+        let ours = msg.transforms.iter().any(|t| t.child_frame_id.trim_start_matches('/').strip_prefix(prefix.as_str()).is_some_and(|l| robot.link(l).is_some()));
+        if !ours {
+            let first = msg.transforms.first().map_or("", |t| t.child_frame_id.as_str());
+            return Err(self.skip(SkipCause::NotOurRobot, format!("/tf: frames unknown to the robot (e.g. '{first}', frame_prefix '{prefix}')")));
+        }
+        let mut world_poses = vec![None; robot.links.len()];
+        for t in checker.targets() {
+            let frame = format!("{prefix}{}", t.name);
+            match self.tf.world_pose(&frame, world) {
+                Some(p) => world_poses[t.link] = Some(p),
+                None => return Err(self.skip(SkipCause::Unreachable, format!("/tf: frame '{frame}' does not reach world_frame '{world}' yet"))),
+            }
+        }
+        let stamp = msg.transforms.iter().map(|t| t.header.stamp).max().unwrap_or_default();
+        Ok(RobotState { stamp, pose: StatePose::Links(world_poses) })
+    }
+
+    /// Checks a state. A state the checker cannot take (it cannot happen for states this
+    /// pipeline made from the current robot) fails closed.
+    pub fn check(&self, state: &RobotState) -> CheckedState {
+        let result = match &state.pose {
+            StatePose::Joints(q) => self.checker.check_positions(q),
+            StatePose::Links(world) => self.checker.check_world_poses(world),
+        };
+        CheckedState { stamp: state.stamp, report: result.unwrap_or_else(|e| StateReport::failed(e.to_string())) }
+    }
+
+    /// A `check_states` request: every state on its own, every name a joint of the robot; one
+    /// report per state, in order, a state that cannot be checked failing closed in its slot.
+    /// Checked on all cores with the `parallel` feature.
+    pub fn check_request(&self, states: &[JointState]) -> Vec<CollisionReport> {
+        let pairs: Vec<(&[String], &[f64])> = states.iter().map(|s| (s.name.as_slice(), s.position.as_slice())).collect();
+        let frame = &self.params().world_frame;
+        self.checker
+            .check_joints_batch(&pairs)
+            .into_iter()
+            .zip(states)
+            .map(|(r, s)| {
+                let report = r.unwrap_or_else(|e| StateReport::failed(e.to_string()));
+                CheckedState { stamp: s.header.stamp, report }.message(frame)
+            })
+            .collect()
+    }
+
+    /// A new robot from URDF text (a `robot_description` message), swapped in whole; on error the
+    /// current robot stays. Merged joint positions are dropped when the new robot's joints differ.
+    pub fn set_robot_description(&mut self, urdf: &str, source: &str) -> Result<(), CheckerError> {
+        let checker = Checker::from_description(self.params().clone(), urdf, source, self.environment.as_deref())?;
+        self.source = RobotSource::Description { urdf: urdf.into(), source: source.to_owned() };
+        self.replace(checker);
+        Ok(())
+    }
+
+    /// New parameters: the checker is rebuilt with the robot from the same source (a robot
+    /// received as a description stays); on error everything stays as it was.
+    pub fn set_params(&mut self, params: Params) -> Result<(), CheckerError> {
+        let checker = match &self.source {
+            RobotSource::Files { robot } => Checker::from_params(params, robot.as_deref(), self.environment.as_deref())?,
+            RobotSource::Description { urdf, source } => Checker::from_description(params, urdf, source, self.environment.as_deref())?,
+        };
+        self.replace(checker);
+        Ok(())
+    }
+
+    fn replace(&mut self, checker: Checker) {
+        let same_joints = checker.robot().joints.iter().map(|j| &j.name).eq(self.checker.robot().joints.iter().map(|j| &j.name));
+        if !same_joints {
+            self.joints = JointInput::new(checker.robot());
+        }
+        self.checker = Arc::new(checker);
+    }
+}
+
+impl std::fmt::Debug for Pipeline {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pipeline").field("source", &self.source).field("skipped", &self.skipped).finish_non_exhaustive()
+    }
+}

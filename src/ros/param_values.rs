@@ -1,0 +1,73 @@
+//! The node's parameters as ROS 2 parameter values: declared from [`Params::flat`], and a value
+//! set through the parameter services turned back into typed parameters.
+
+use crate::model::Params;
+use ros2_client::ParameterValue;
+use serde_json::Value;
+
+/// Parameters that shape the node's topics and services, fixed once they are created.
+pub const READ_ONLY: [&str; 3] = ["pose_source", "service_mapping", "use_sim_time"];
+
+/// Every parameter with its ROS 2 value. An empty list takes its element type from
+/// [`Params::array_kinds`] (JSON cannot tell an empty list of numbers from one of strings).
+pub fn declarations(params: &Params) -> Vec<(String, ParameterValue)> {
+    let kinds = Params::array_kinds();
+    params
+        .flat()
+        .into_iter()
+        .map(|(name, v)| {
+            let value = match v {
+                Value::Array(a) if a.is_empty() => match kinds.iter().find(|(n, _)| *n == name).map(|(_, k)| k.clone()) {
+                    Some(Value::Number(_)) => ParameterValue::DoubleArray(vec![]),
+                    _ => ParameterValue::StringArray(vec![]),
+                },
+                v => to_parameter(&v),
+            };
+            (name, value)
+        })
+        .collect()
+}
+
+fn to_parameter(v: &Value) -> ParameterValue {
+    match v {
+        Value::Bool(b) => ParameterValue::Boolean(*b),
+        Value::Number(n) if n.is_f64() => ParameterValue::Double(n.as_f64().unwrap_or(f64::NAN)),
+        Value::Number(n) => n.as_i64().map_or(ParameterValue::Double(n.as_f64().unwrap_or(f64::NAN)), ParameterValue::Integer),
+        Value::String(s) => ParameterValue::String(s.clone()),
+        Value::Array(a) if a.iter().all(Value::is_number) => ParameterValue::DoubleArray(a.iter().filter_map(Value::as_f64).collect()),
+        Value::Array(a) => ParameterValue::StringArray(a.iter().map(|x| x.as_str().map_or_else(|| x.to_string(), str::to_owned)).collect()),
+        Value::Null | Value::Object(_) => ParameterValue::NotSet,
+    }
+}
+
+/// A parameter value as JSON, for [`Params::with_value`] (which checks its type).
+pub fn to_json(value: &ParameterValue) -> Value {
+    let num = |x: f64| serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number);
+    match value {
+        ParameterValue::NotSet => Value::Null,
+        ParameterValue::Boolean(b) => Value::Bool(*b),
+        ParameterValue::Integer(i) => Value::from(*i),
+        ParameterValue::Double(d) => num(*d),
+        ParameterValue::String(s) => Value::String(s.clone()),
+        ParameterValue::ByteArray(a) => Value::Array(a.iter().map(|x| Value::from(*x)).collect()),
+        ParameterValue::BooleanArray(a) => Value::Array(a.iter().map(|x| Value::Bool(*x)).collect()),
+        ParameterValue::IntegerArray(a) => Value::Array(a.iter().map(|x| Value::from(*x)).collect()),
+        ParameterValue::DoubleArray(a) => Value::Array(a.iter().map(|x| num(*x)).collect()),
+        ParameterValue::StringArray(a) => Value::Array(a.iter().map(|x| Value::String(x.clone())).collect()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn declared_values_set_back_to_the_same_parameters() {
+        let p = Params::default();
+        for (name, value) in declarations(&p) {
+            assert_eq!(p.with_value(&name, to_json(&value)).unwrap(), p, "{name} = {value:?}");
+        }
+        let kinds: Vec<_> = declarations(&p).into_iter().filter(|(n, _)| n == "padding.values" || n == "thin_surfaces.thickness").collect();
+        assert!(kinds.iter().all(|(_, v)| matches!(v, ParameterValue::DoubleArray(_))), "{kinds:?}");
+    }
+}

@@ -1,0 +1,263 @@
+//! One pipeline, two doors: the same message sequences, sent live to the running node over DDS
+//! by an independent participant (Cyclone DDS from Python) and written by `rosbags` into a bag
+//! with the same stamps for `replay`, give equal reports (flags, links, depths, stamps, errors)
+//! and equal skip counts per cause. (a) joint states: partial states from two publishers, a NaN
+//! state, a wrong-length state, unknown names; (b) `/tf` with `frame_prefix: robot1/`: prefixed
+//! frames, `/tf_static`, another robot's frames, a non-finite transform, a frame that does not
+//! reach the world. Also `check_states`: bad states fail closed in their slots, good ones equal
+//! `check --json`. Loopback only (see tests/ros_node.rs).
+
+mod common;
+
+use serde_json::{json, Value};
+use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use thickness_collision::checker::Checker;
+use thickness_collision::math::pose_from_isometry;
+use thickness_collision::model::Params;
+
+const CYCLONE_LOOPBACK: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers><Peer address="127.0.0.1"/></Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>"#;
+const ARM: [&str; 6] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"];
+const FINGER: &str = "finger_left_joint";
+const T0: i64 = 1_700_000_000_000_000_000;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tc_one_pipeline_{}_{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Arm positions that sweep the bundled arm through the workcell (some colliding, some not).
+fn arm(k: usize) -> Vec<f64> {
+    let x = k as f64;
+    vec![(0.37 * x).sin() * 1.5, 0.3 + (0.23 * x).cos() * 1.1, (0.11 * x).sin() * 1.6, 0.2 * x % 3.0, (0.5 * x).cos() * 1.5, 0.1 * x]
+}
+
+fn js(k: usize, names: Vec<&str>, position: Vec<Value>) -> Value {
+    let t = T0 + k as i64 * 10_000_000;
+    json!({"topic": "/joint_states", "t": t, "stamp": t - 777, "name": names, "position": position})
+}
+
+fn nums(v: &[f64]) -> Vec<Value> {
+    v.iter().map(|x| json!(x)).collect()
+}
+
+/// (a): a full state first (the live peer's warm-up), then partial states from an arm publisher
+/// and a gripper publisher, and the bad ones.
+fn joint_sequence() -> Vec<Value> {
+    let mut m = Vec::new();
+    let full = |k: usize| {
+        let mut names = ARM.to_vec();
+        names.push(FINGER);
+        let mut p = arm(k);
+        p.push(0.01);
+        (names, nums(&p))
+    };
+    let (n, p) = full(0);
+    m.push(js(0, n, p));
+    let mut k = 1;
+    for step in 0..18 {
+        let msg = match step {
+            3 => js(k, vec!["elbow_joint", "wrist_1_joint"], vec![json!(0.2), json!("NaN")]),
+            6 => js(k, ARM[..3].to_vec(), nums(&arm(k)[..2])),
+            9 => {
+                let mut names = vec!["robot2/elbow_joint", "robot2/wrist_1_joint"];
+                names.extend(ARM);
+                let mut p = vec![json!(9.0), json!("NaN")];
+                p.extend(nums(&arm(k)));
+                js(k, names, p)
+            }
+            12 => js(k, vec![], vec![]),
+            s if s % 2 == 0 => js(k, ARM.to_vec(), nums(&arm(k))),
+            _ => js(k, vec![FINGER], vec![json!(0.001 * k as f64)]),
+        };
+        m.push(msg);
+        k += 1;
+    }
+    m
+}
+
+fn tf_of(k: usize, prefix: &str, parent: &str, q: &[f64]) -> Value {
+    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let mut full = vec![0.0; checker.robot().joints.len()];
+    for (n, v) in ARM.iter().zip(q) {
+        full[checker.robot().joint(n).unwrap()] = *v;
+    }
+    let poses = checker.robot().forward_kinematics(&full, &nalgebra::Isometry3::identity()).unwrap();
+    let transforms: Vec<Value> = checker
+        .targets()
+        .iter()
+        .map(|t| {
+            let p = pose_from_isometry(&poses[t.link]);
+            json!({"parent": parent, "child": format!("{prefix}{}", t.name), "translation": p.translation.to_array(), "rotation": [p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w]})
+        })
+        .collect();
+    let t = T0 + k as i64 * 10_000_000;
+    json!({"topic": "/tf", "t": t, "stamp": t - 555, "transforms": transforms})
+}
+
+/// (b): prefixed frames of robot1, /tf_static, another robot, a NaN, an unreachable parent.
+fn tf_sequence() -> Vec<Value> {
+    let mut m = vec![tf_of(0, "robot1/", "world", &arm(0))];
+    let t = T0 + 5_000_000;
+    m.push(json!({"topic": "/tf_static", "t": t, "stamp": t, "transforms": [{"parent": "world", "child": "robot1/odom", "translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0, 1.0]}]}));
+    for k in 1..14 {
+        let msg = match k {
+            3 => tf_of(k, "robot2/", "world", &arm(k)),
+            5 => {
+                let mut bad = tf_of(k, "robot1/", "world", &arm(k));
+                bad["transforms"][2]["translation"][1] = json!("NaN");
+                bad
+            }
+            7 => tf_of(k, "robot1/", "robot1/not_connected", &arm(k)),
+            k if k % 2 == 0 => tf_of(k, "robot1/", "robot1/odom", &arm(k)),
+            _ => tf_of(k, "robot1/", "world", &arm(k)),
+        };
+        m.push(msg);
+    }
+    m
+}
+
+fn cyclone_config(d: &Path) -> PathBuf {
+    let f = d.join("cyclone.xml");
+    std::fs::write(&f, CYCLONE_LOOPBACK).unwrap();
+    f
+}
+
+fn peer(request: &Value, cyclone: Option<&Path>) -> Value {
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/sequence_peer.py");
+    let mut c = Command::new(common::python());
+    let _ = c.arg(&script).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped());
+    if let Some(f) = cyclone {
+        let _ = c.env("CYCLONEDDS_URI", format!("file://{}", f.display()));
+    }
+    let mut child = c.spawn().unwrap();
+    child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success(), "sequence_peer.py: {}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+/// Runs the node with `args` (loopback only) while the peer sends `messages`; returns the reports
+/// and the node's skip counts by cause from its last `/diagnostics`.
+fn live(messages: &[Value], args: &[&str], domain: u32, d: &Path) -> (Vec<Value>, BTreeMap<String, u64>) {
+    let mut node = bin()
+        .arg("run")
+        .args(args)
+        .env("ROS_DOMAIN_ID", domain.to_string())
+        .env("ROS_LOCALHOST_ONLY", "1")
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(node.stdout.take().unwrap());
+    let mut banner = String::new();
+    while !banner.contains("serves") {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
+        banner += &line;
+    }
+    let answer = peer(&json!({"op": "live", "domain": domain, "messages": messages, "timeout": 30}), Some(&cyclone_config(d)));
+    let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
+    assert!(node.wait().unwrap().success());
+    let mut err = String::new();
+    let _ = std::io::Read::read_to_string(&mut node.stderr.take().unwrap(), &mut err);
+    eprintln!("node stderr:\n{err}");
+    let diag = answer["diagnostics"].as_object().unwrap_or_else(|| panic!("no /diagnostics: {answer}"));
+    let skips = diag
+        .iter()
+        .filter_map(|(k, v)| Some((k.strip_prefix("skipped_")?.to_owned(), v.as_str()?.parse::<u64>().ok()?)))
+        .filter(|(k, n)| k != "stale" && *n > 0)
+        .collect();
+    (answer["reports"].as_array().unwrap().clone(), skips)
+}
+
+/// Replays `messages` from a bag written by rosbags; returns the JSON lines and the skip counts
+/// from the summary.
+fn replayed(messages: &[Value], params: &Path, d: &Path, storage: &str) -> (Vec<Value>, BTreeMap<String, u64>) {
+    let bag = d.join(format!("bag_{storage}"));
+    let _ = peer(&json!({"op": "bag", "path": bag, "storage": storage, "messages": messages}), None);
+    let jsonl = d.join(format!("out_{storage}.jsonl"));
+    let topic = if messages.iter().any(|m| m["topic"] == "/tf") { "/tf" } else { "/joint_states" };
+    let o = bin().arg("replay").arg(&bag).args(["--params-file", params.to_str().unwrap(), "--topic", topic, "--jsonl", jsonl.to_str().unwrap()]).output().unwrap();
+    let summary = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "replay: {}\n{summary}", String::from_utf8_lossy(&o.stderr));
+    let mut skips = BTreeMap::new();
+    // "skipped messages: N", then "  n x cause" per cause.
+    for line in summary.lines().skip_while(|l| !l.starts_with("skipped messages:")).skip(1).filter_map(|l| l.trim().split_once(" x ")) {
+        let _ = skips.insert(line.1.to_owned(), line.0.parse::<u64>().unwrap());
+    }
+    let lines = std::fs::read_to_string(&jsonl).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    (lines, skips)
+}
+
+fn same_reports(live: &[Value], replayed: &[Value], what: &str) {
+    assert_eq!(live.len(), replayed.len(), "{what}: report count, live {live:?}\nreplayed {replayed:?}");
+    for (k, (a, b)) in live.iter().zip(replayed).enumerate() {
+        assert_eq!(a["stamp"], b["stamp"], "{what}: report {k} stamp");
+        assert_eq!(a["in_collision"], b["in_collision"], "{what}: report {k}");
+        assert_eq!(a["error"], b["error"], "{what}: report {k}");
+        let (ca, cb) = (a["contacts"].as_array().unwrap(), b["contacts"].as_array().unwrap());
+        assert_eq!(ca.len(), cb.len(), "{what}: report {k}: colliding links");
+        for (x, y) in ca.iter().zip(cb) {
+            for f in ["link_name", "object_name", "triangle"] {
+                assert_eq!(x[f], y[f], "{what}: report {k}: {f}");
+            }
+            assert!((x["depth"].as_f64().unwrap() - y["depth"].as_f64().unwrap()).abs() <= 1e-9, "{what}: report {k}: depth");
+        }
+    }
+}
+
+fn params_file(d: &Path, extra: &str) -> PathBuf {
+    let f = d.join("params.yaml");
+    std::fs::write(&f, format!("thickness_collision:\n  ros__parameters:\n{extra}")).unwrap();
+    f
+}
+
+#[test]
+fn joint_states_live_and_replayed_give_the_same_reports_and_skips() {
+    let d = dir("js");
+    let messages = joint_sequence();
+    let params = params_file(&d, "    missing_joint: last\n");
+    let (live_reports, live_skips) = live(&messages, &["--params-file", params.to_str().unwrap()], 120 + std::process::id() % 40, &d);
+    // 19 messages: the NaN one and the wrong-length one give no report.
+    assert_eq!(live_reports.len(), messages.len() - 2, "{live_reports:?}");
+    assert!(live_reports.iter().any(|r| r["in_collision"] == true) && live_reports.iter().any(|r| r["in_collision"] == false));
+    assert!(live_reports.iter().all(|r| r["error"] == "" && r["frame_id"] == "world"));
+    assert_eq!(live_skips, BTreeMap::from([("lengths".to_owned(), 1), ("non_finite".to_owned(), 1)]));
+    for storage in ["mcap", "sqlite3"] {
+        let (lines, skips) = replayed(&messages, &params, &d, storage);
+        same_reports(&live_reports, &lines, storage);
+        assert_eq!(skips, live_skips, "{storage}: skips by cause");
+    }
+}
+
+#[test]
+fn tf_with_a_frame_prefix_live_and_replayed_give_the_same_reports_and_skips() {
+    let d = dir("tf");
+    let messages = tf_sequence();
+    let params = params_file(&d, "    pose_source: tf\n    frame_prefix: robot1/\n");
+    let (live_reports, live_skips) = live(&messages, &["--params-file", params.to_str().unwrap()], 160 + std::process::id() % 40, &d);
+    // 15 messages: /tf_static, robot2's, the NaN and the unreachable one give no report.
+    assert_eq!(live_reports.len(), messages.len() - 4, "{live_reports:?}");
+    assert!(live_reports.iter().any(|r| r["in_collision"] == true) && live_reports.iter().any(|r| r["in_collision"] == false));
+    let want = BTreeMap::from([("bad_transform".to_owned(), 1), ("not_our_robot".to_owned(), 1), ("unreachable".to_owned(), 1)]);
+    assert_eq!(live_skips, want);
+    let (lines, skips) = replayed(&messages, &params, &d, "mcap");
+    same_reports(&live_reports, &lines, "tf");
+    assert_eq!(skips, live_skips);
+    // Without the prefix every message is somebody else's: nothing is reported as checked.
+    let plain = params_file(&d, "    pose_source: tf\n");
+    let (lines, skips) = replayed(&messages, &plain, &d, "sqlite3");
+    assert!(lines.is_empty(), "{lines:?}");
+    assert_eq!(skips.get("not_our_robot"), Some(&((messages.len() - 2) as u64)), "every /tf but the NaN one");
+    assert_eq!(skips.get("bad_transform"), Some(&1));
+}
