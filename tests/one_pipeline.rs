@@ -62,8 +62,7 @@ fn joint_sequence() -> Vec<Value> {
     };
     let (n, p) = full(0);
     m.push(js(0, n, p));
-    let mut k = 1;
-    for step in 0..18 {
+    for (k, step) in (1..).zip(0..18) {
         let msg = match step {
             3 => js(k, vec!["elbow_joint", "wrist_1_joint"], vec![json!(0.2), json!("NaN")]),
             6 => js(k, ARM[..3].to_vec(), nums(&arm(k)[..2])),
@@ -79,7 +78,6 @@ fn joint_sequence() -> Vec<Value> {
             _ => js(k, vec![FINGER], vec![json!(0.001 * k as f64)]),
         };
         m.push(msg);
-        k += 1;
     }
     m
 }
@@ -260,4 +258,45 @@ fn tf_with_a_frame_prefix_live_and_replayed_give_the_same_reports_and_skips() {
     assert!(lines.is_empty(), "{lines:?}");
     assert_eq!(skips.get("not_our_robot"), Some(&((messages.len() - 2) as u64)), "every /tf but the NaN one");
     assert_eq!(skips.get("bad_transform"), Some(&1));
+}
+
+#[test]
+fn a_robot_description_in_the_bag_applies_from_its_log_time() {
+    use thickness_collision::model::bundled_config_dir;
+    let d = dir("desc");
+    // The bundled arm with a fat forearm (radius 0.3 instead of 0.04): it reaches walls it did not.
+    let gripper = bundled_config_dir().join("example_workcell/gripper.obj");
+    let urdf = std::fs::read_to_string(bundled_config_dir().join("example_workcell/robot.urdf"))
+        .unwrap()
+        .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", gripper.display()))
+        .replace("<capsule radius=\"0.04\"", "<capsule radius=\"0.3\"");
+    let fat = d.join("fat_arm.urdf");
+    std::fs::write(&fat, &urdf).unwrap();
+    let mut names = ARM.to_vec();
+    names.push(FINGER);
+    let states: Vec<Value> = (0..40).map(|k| js(k, names.clone(), nums(&[arm(k), vec![0.01]].concat()))).collect();
+    let mut messages = states.clone();
+    let at = states[20]["t"].as_i64().unwrap() - 1;
+    messages.insert(20, json!({"topic": "/robot_description", "t": at, "data": urdf}));
+    let params = params_file(&d, "    missing_joint: last\n");
+    let (lines, _) = replayed(&messages, &params, &d, "mcap");
+    // check on the same states: the parameters' robot, and the fat one.
+    let file = d.join("states.jsonl");
+    let text: Vec<String> = states.iter().map(|m| json!({"name": m["name"], "position": m["position"], "stamp": m["stamp"]}).to_string()).collect();
+    std::fs::write(&file, text.join("\n") + "\n").unwrap();
+    let check = |robot: Option<&Path>| -> Vec<Value> {
+        let mut c = bin();
+        let _ = c.args(["check", "--params-file", params.to_str().unwrap(), "--states", file.to_str().unwrap(), "--json"]);
+        if let Some(r) = robot {
+            let _ = c.args(["--robot", r.to_str().unwrap()]);
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+    };
+    let (thin, fat) = (check(None), check(Some(&fat)));
+    let differ = |range: std::ops::Range<usize>| range.filter(|&k| thin[k]["contacts"] != fat[k]["contacts"]).count();
+    assert!(differ(0..20) > 0 && differ(20..40) > 0, "the fat forearm must change some answers on both sides");
+    same_reports(&lines[..20], &thin[..20], "before the description");
+    same_reports(&lines[20..], &fat[20..], "after the description");
 }

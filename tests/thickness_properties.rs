@@ -28,6 +28,7 @@
 //!    grows as the face's angle at that vertex narrows; diverging cells reach past their faces;
 //! 2. on sharp folds the other sheet can lie within `t` of the point without crossing its ray,
 //!    and its cells then hold the point too.
+//!
 //! So for every point that passes the design's exclusions the test asserts: never in the cells of
 //! two faces that share an edge (their common wall is exact); on the other side, never in the cell
 //! of the point's face or an edge neighbour; no violation at all farther than `2 t / sin(a/2)`
@@ -1245,8 +1246,8 @@ fn gap_and_overlap_volume_fractions() {
     eprintln!("of the surface and behind it by their closest feature, >= 2t from boundary edges, NOT excluded near vertices; 'far' = the subset outside every");
     eprintln!("vertex radius t/sin(a/2); pairs: overlaps between cells of faces sharing nothing / a vertex / an edge");
     eprintln!(
-        "{:<38} {:>6} {:>5} {:>6} {:>7} {:>9} | {:>6} {:>7} {:>9} | {}",
-        "mesh", "t/edge", "t/R", "points", "gap %", "overlap %", "far", "gap %", "overlap %", "pairs"
+        "{:<38} {:>6} {:>5} {:>6} {:>7} {:>9} | {:>6} {:>7} {:>9} | pairs",
+        "mesh", "t/edge", "t/R", "points", "gap %", "overlap %", "far", "gap %", "overlap %"
     );
     for (name, soup, t, radius, bound) in meshes {
         let pose = random_pose(&mut rng);

@@ -363,7 +363,7 @@ fn check_rule(b: &Built) -> [usize; 4] {
             Some(_) => CellKind::Ratioed,
         };
         // Near the thresholds the two computations may round differently.
-        let near_threshold = h.map_or(true, |h| (h - t).abs() < 1e-9 * scale || h.abs() < 1e-9 * scale || h > 1e6 * scale);
+        let near_threshold = h.is_none_or(|h| (h - t).abs() < 1e-9 * scale || h.abs() < 1e-9 * scale || h > 1e6 * scale);
         if near_threshold {
             // Parallel in one computation, converging very far away in the other: both are prisms
             // to within 1e-6 of the face size.

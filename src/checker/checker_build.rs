@@ -378,7 +378,7 @@ impl Checker {
                     continue;
                 }
                 if let Some(c) = r.deepest() {
-                    if best.as_ref().map_or(true, |b| c.depth > b.depth) {
+                    if best.as_ref().is_none_or(|b| c.depth > b.depth) {
                         best = Some(*c);
                     }
                 }

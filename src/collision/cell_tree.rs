@@ -306,7 +306,7 @@ impl Builder<'_> {
                 sum += self.cells[i as usize].normal;
             }
             let axis = unit_or(sum, self.cells[ids[0] as usize].normal);
-            let (mut spread, mut top, mut bottom) = (0.0 as Real, Real::NEG_INFINITY, Real::INFINITY);
+            let (mut spread, mut top, mut bottom) = (Real::default(), Real::NEG_INFINITY, Real::INFINITY);
             for &i in ids {
                 let cell = &self.cells[i as usize];
                 spread = spread.max((cell.normal - axis).length());

@@ -11,6 +11,8 @@ use super::gjk::{self, Verdict};
 use super::sat::SatOverlap;
 
 /// What an environment object is made of.
+// A scene holds a handful of objects; boxing the surface would add an indirection to every query.
+#[allow(clippy::large_enum_variant)]
 pub enum ObjectBody {
     /// A thin surface: its cells in a BVH.
     Surface {
@@ -139,7 +141,7 @@ impl Scene {
                         }
                         if settings.all_contacts {
                             report.contacts.push(contact);
-                        } else if deepest.as_ref().map_or(true, |d| contact.depth > d.depth) {
+                        } else if deepest.as_ref().is_none_or(|d| contact.depth > d.depth) {
                             deepest = Some(contact);
                         }
                     }
@@ -193,7 +195,7 @@ impl Scene {
                 }
             } else if let Some((depth, leaf, push, sat)) = deepest_cell(tree, area, &view, &mut report.candidates, settings.least_overlap) {
                 hit_object = true;
-                if deepest.as_ref().map_or(true, |d| depth > d.depth) {
+                if deepest.as_ref().is_none_or(|d| depth > d.depth) {
                     let cell = &area.cells[leaf as usize];
                     let position = LocalPair::new(target, cell, &pos12).point(push).map(|p| target.pose * p);
                     let least = sat.map(|s| LeastOverlap { overlap: s.overlap, axis: rot * s.axis });

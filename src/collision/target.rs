@@ -260,7 +260,7 @@ impl ConvexHull {
     /// [`ConvexHull::climb`] and the vertex it ends at.
     #[inline]
     fn climb_vertex(&self, dir: Vector) -> (Real, usize) {
-        self.from_entry(dir, self.entry(dir))
+        self.climb_from_entry(dir, self.entry(dir))
     }
 
     /// The cube-map entry of `dir`; with no map (a hull of `2^15` vertices or more), vertex 0.
@@ -271,7 +271,7 @@ impl ConvexHull {
 
     /// The extreme along `dir` from its cube-map entry: the flagged vertex, or a climb from it.
     #[inline]
-    fn from_entry(&self, dir: Vector, entry: u16) -> (Real, usize) {
+    fn climb_from_entry(&self, dir: Vector, entry: u16) -> (Real, usize) {
         if entry & EXACT != 0 {
             let at = (entry & !EXACT) as usize;
             return (dir.dot(self.points[at]), at);
@@ -314,7 +314,7 @@ impl ConvexHull {
             *e = self.entry(*d);
         }
         for ((e, d), o) in entries.iter().zip(dirs).zip(out) {
-            *o = self.from_entry(*d, *e).0;
+            *o = self.climb_from_entry(*d, *e).0;
         }
     }
 

@@ -217,7 +217,7 @@ impl Params {
             return bad("robot_base_pose", format!("needs 6 finite numbers (x y z roll pitch yaw), got {:?}", self.robot_base_pose));
         }
         if !(self.default_thickness > 0.0 && self.default_thickness.is_finite()) {
-            return bad("default_thickness", format!("must be a positive number of metres, got {}", self.default_thickness));
+            return bad("default_thickness", format!("must be a positive number of metres, got {:?}", self.default_thickness));
         }
         let ts = &self.thin_surfaces;
         if ts.thickness.len() != ts.patterns.len() {
@@ -227,13 +227,13 @@ impl Params {
             return bad("thin_surfaces.side", format!("has {} values for {} patterns", ts.side.len(), ts.patterns.len()));
         }
         if let Some(t) = ts.thickness.iter().find(|t| !(**t > 0.0 && t.is_finite())) {
-            return bad("thin_surfaces.thickness", format!("must be positive, got {t}"));
+            return bad("thin_surfaces.thickness", format!("must be positive, got {t:?}"));
         }
         if self.padding.values.len() != self.padding.links.len() {
             return bad("padding.values", format!("has {} values for {} link patterns", self.padding.values.len(), self.padding.links.len()));
         }
         if let Some(p) = self.padding.values.iter().find(|p| !(**p >= 0.0 && p.is_finite())) {
-            return bad("padding.values", format!("must be >= 0, got {p}"));
+            return bad("padding.values", format!("must be >= 0, got {p:?}"));
         }
         if let Some(p) = self.allowed_collisions.iter().find(|p| p.split(':').count() != 2 || p.split(':').any(str::is_empty)) {
             return bad("allowed_collisions", format!("'{p}' is not of the form robot_link:environment_link"));
@@ -243,7 +243,7 @@ impl Params {
         }
         let (lo, hi) = MARKER_RATE_RANGE;
         if !(self.marker_rate >= lo && self.marker_rate <= hi) {
-            return bad("marker_rate", format!("must be a rate from {lo} to {hi} Hz, got {}", self.marker_rate));
+            return bad("marker_rate", format!("must be a rate from {lo} to {hi} Hz, got {:?}", self.marker_rate));
         }
         if self.world_frame.trim_start_matches('/').is_empty() {
             return bad("world_frame", format!("must name a frame, got '{}'", self.world_frame));

@@ -167,7 +167,7 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
         }
         let t0 = *t0.get_or_insert(m.log_time);
         let seconds = (m.log_time - t0) as f64 * 1e-9;
-        let in_window = opts.start.map_or(true, |a| seconds >= a) && opts.end.map_or(true, |b| seconds <= b);
+        let in_window = opts.start.is_none_or(|a| seconds >= a) && opts.end.is_none_or(|b| seconds <= b);
         let state = if m.topic == DESCRIPTION_TOPIC {
             apply_description(&mut pipeline, &m, &opts.bag, &mut summary, &mut warnings);
             continue;
@@ -251,7 +251,7 @@ fn record(summary: &mut ReplaySummary, checked: &CheckedState) {
         summary.in_collision += 1;
     }
     for c in &checked.report.contacts {
-        if summary.deepest.as_ref().map_or(true, |d| c.depth > d.3) {
+        if summary.deepest.as_ref().is_none_or(|d| c.depth > d.3) {
             summary.deepest = Some((summary.states, c.link_name.clone(), c.object_name.clone(), c.depth));
         }
     }

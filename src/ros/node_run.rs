@@ -303,7 +303,7 @@ impl NodeState {
         let rate = self.pipeline.params().marker_rate;
         // marker_rate is validated to [1e-3, 1e4] Hz; the fallback only guards the arithmetic.
         let period = Duration::try_from_secs_f64(1.0 / rate).unwrap_or(Duration::from_secs(1));
-        if self.last_markers.map_or(true, |t| t.elapsed() >= period) {
+        if self.last_markers.is_none_or(|t| t.elapsed() >= period) {
             self.last_markers = Some(Instant::now());
             if io.contacts.publish(contact_markers(&checked.report, &world, checked.stamp)).is_err() {
                 self.log.warn("markers", || format!("publishing {} failed", io.names.contacts));

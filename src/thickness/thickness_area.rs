@@ -182,7 +182,7 @@ fn cross_point(p: [Vector; 3], n: Vector, walls: [Vector; 3]) -> Option<(Vector,
 /// The two caps and the kind of the cell of face `p` (normal `n`, inward wall normals `walls`).
 #[inline]
 fn face_cell(p: [Vector; 3], n: Vector, walls: [Vector; 3], t: Real, side: Side) -> Option<([Vector; 3], [Vector; 3], CellKind)> {
-    if walls.iter().any(|w| *w == Vector::ZERO) {
+    if walls.contains(&Vector::ZERO) {
         return None;
     }
     let cross = cross_point(p, n, walls);

@@ -5,6 +5,7 @@ with the same stamps, for `replay`.
 stdin: {"op": "live", "domain": id, "ns": "", "messages": [...], "timeout": s}
        {"op": "bag", "path": dir, "storage": "mcap" | "sqlite3", "messages": [...]}
 A message: {"topic": "/joint_states" | "/tf" | "/tf_static", "t": log time ns, "stamp": ns,
+            (bags only: {"topic": "/robot_description", "t": ns, "data": urdf}),
             "name": [...], "position": [... numbers or "NaN"]} or {..., "transforms":
             [{"parent", "child", "translation": [x,y,z], "rotation": [x,y,z,w]}]}.
 Live pacing: each message is sent after the previous one's report, or after 0.5 s for one that
@@ -130,10 +131,12 @@ def bag(req):
         for m in req["messages"]:
             topic = m["topic"]
             if topic not in conns:
-                ty = "sensor_msgs/msg/JointState" if topic == "/joint_states" else "tf2_msgs/msg/TFMessage"
+                ty = {"/joint_states": "sensor_msgs/msg/JointState", "/robot_description": "std_msgs/msg/String"}.get(topic, "tf2_msgs/msg/TFMessage")
                 conns[topic] = w.add_connection(topic, ty, typestore=store)
             c = conns[topic]
-            if topic == "/joint_states":
+            if topic == "/robot_description":
+                msg = S["std_msgs/msg/String"](data=m["data"])
+            elif topic == "/joint_states":
                 msg = S["sensor_msgs/msg/JointState"](header=header(int(m["stamp"]), ""), name=m["name"],
                                                       position=np.array([num(x) for x in m["position"]], dtype=np.float64),
                                                       velocity=np.array([], dtype=np.float64), effort=np.array([], dtype=np.float64))
