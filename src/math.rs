@@ -50,12 +50,3 @@ pub fn pose_from_isometry(iso: &nalgebra::Isometry3<Real>) -> Pose {
     Pose::from_parts(Vector::new(t.x, t.y, t.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w))
 }
 
-/// glam/parry to nalgebra.
-pub fn isometry_from_pose(pose: &Pose) -> nalgebra::Isometry3<Real> {
-    let q = pose.rotation;
-    let t = pose.translation;
-    nalgebra::Isometry3::from_parts(
-        nalgebra::Translation3::new(t.x, t.y, t.z),
-        nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(q.w, q.x, q.y, q.z)),
-    )
-}

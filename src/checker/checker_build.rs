@@ -125,18 +125,25 @@ impl MeshCache {
     }
 }
 
+/// The target of a URDF primitive grown by `padding`; `None` for meshes and for sizes that are not
+/// positive and finite.
 fn primitive_shape(spec: &GeometrySpec, padding: f64) -> Option<TargetShape> {
-    Some(match spec {
+    let shape = match spec {
         GeometrySpec::Box(s) => TargetShape::cuboid(Vector::new(s[0], s[1], s[2]) * 0.5 + Vector::splat(padding))?,
         GeometrySpec::Sphere(r) => TargetShape::Sphere { radius: r + padding },
         GeometrySpec::Capsule { radius, length } => TargetShape::Capsule { half_height: length / 2.0, radius: radius + padding },
         GeometrySpec::Cylinder { radius, length } => TargetShape::Cylinder { half_height: length / 2.0 + padding, radius: radius + padding },
         GeometrySpec::Mesh { .. } => return None,
-    })
+    };
+    shape.is_valid().then_some(shape)
 }
 
+/// `robot_base_pose` (x y z roll pitch yaw) as an isometry; `Params::validate` ensures six values.
 fn base_isometry(p: &[f64]) -> Isometry3<f64> {
-    Isometry3::from_parts(Translation3::new(p[0], p[1], p[2]), UnitQuaternion::from_euler_angles(p[3], p[4], p[5]))
+    match *p {
+        [x, y, z, roll, pitch, yaw] => Isometry3::from_parts(Translation3::new(x, y, z), UnitQuaternion::from_euler_angles(roll, pitch, yaw)),
+        _ => Isometry3::identity(),
+    }
 }
 
 impl Checker {

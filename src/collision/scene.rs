@@ -214,11 +214,6 @@ impl Scene {
     pub fn cell_count(&self) -> usize {
         self.objects.iter().filter_map(|o| o.area()).map(|a| a.cells.len()).sum()
     }
-
-    /// Checks several targets (one report each, in order).
-    pub fn collide_many(&self, targets: &[Target], settings: &CollideSettings) -> Vec<TargetReport> {
-        targets.iter().map(|t| self.collide(t, settings)).collect()
-    }
 }
 
 /// A target against a convex solid, with parry's GJK/EPA: the depth is the penetration depth, the
