@@ -670,11 +670,27 @@ mod tests {
     use std::collections::BTreeMap;
     use std::io::Cursor;
 
-    fn scratch(name: &str) -> PathBuf {
+    /// A temporary directory, removed when the test ends.
+    struct Scratch(PathBuf);
+
+    impl std::ops::Deref for Scratch {
+        type Target = Path;
+        fn deref(&self) -> &Path {
+            &self.0
+        }
+    }
+
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    fn scratch(name: &str) -> Scratch {
         let d = std::env::temp_dir().join(format!("tc_bag_reader_{}_{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
-        d
+        Scratch(d)
     }
 
     /// An MCAP file with two topics (the second declared after messages of the first).
@@ -975,6 +991,12 @@ mod tests {
         let e = open_bag(&bad).unwrap_err().to_string();
         assert!(e.contains("bad.db3"), "{e}");
     }
+
+    /// A reader can move to another thread.
+    const _: fn() = || {
+        fn send<T: Send>() {}
+        send::<BagReader>();
+    };
 
     #[test]
     fn schema_and_channel_string_checks() {
