@@ -22,8 +22,8 @@ use std::time::{Duration, Instant};
 use thickness_collision::collision::CellTree;
 use thickness_collision::math::Vector;
 use thickness_collision::mesh::{weld, MeshTopology, TopologySettings};
-use wall_1m::{checksum, wall};
 use thickness_collision::thickness::{ThicknessArea, ThicknessCell, ThicknessSettings};
+use wall_1m::{checksum, wall};
 
 fn whole(v: &[Vector], t: &[[u32; 3]], topo: &TopologySettings, cells: &ThicknessSettings) -> (ThicknessArea, CellTree) {
     let welded = weld(v, t, topo).expect("weld");
@@ -86,29 +86,18 @@ fn bench_build(c: &mut Criterion) {
     drop(tree);
 
     let mut g = c.benchmark_group("build_1M_wall");
-    g.sample_size(10)
-        .sampling_mode(SamplingMode::Flat)
-        .warm_up_time(Duration::from_millis(500))
-        .throughput(Throughput::Elements(t.len() as u64));
+    g.sample_size(10).sampling_mode(SamplingMode::Flat).warm_up_time(Duration::from_millis(500)).throughput(Throughput::Elements(t.len() as u64));
     // Measurement times: 10 iterations of each stage on this machine (2 cores, noisy), the whole
     // benchmark under 2 minutes.
     g.measurement_time(Duration::from_secs(6));
-    g.bench_function("weld", |b| {
-        b.iter_batched(|| (), |()| weld(black_box(&v), black_box(&t), &topo).expect("weld"), BatchSize::PerIteration)
-    });
+    g.bench_function("weld", |b| b.iter_batched(|| (), |()| weld(black_box(&v), black_box(&t), &topo).expect("weld"), BatchSize::PerIteration));
     g.measurement_time(Duration::from_secs(4));
-    g.bench_function("topology", |b| {
-        b.iter_batched(|| welded.clone(), MeshTopology::from_welded, BatchSize::PerIteration)
-    });
-    g.bench_function("cells", |b| {
-        b.iter_batched(|| (), |()| ThicknessArea::build(black_box(&mesh), &settings).expect("cells"), BatchSize::PerIteration)
-    });
+    g.bench_function("topology", |b| b.iter_batched(|| welded.clone(), MeshTopology::from_welded, BatchSize::PerIteration));
+    g.bench_function("cells", |b| b.iter_batched(|| (), |()| ThicknessArea::build(black_box(&mesh), &settings).expect("cells"), BatchSize::PerIteration));
     g.measurement_time(Duration::from_secs(7));
     g.bench_function("tree", |b| b.iter_batched(|| area.cells.clone(), |mut cells| CellTree::build(black_box(&mut cells)), BatchSize::PerIteration));
     g.measurement_time(Duration::from_secs(20));
-    g.bench_function("whole", |b| {
-        b.iter_batched(|| (), |()| whole(black_box(&v), black_box(&t), &topo, &settings), BatchSize::PerIteration)
-    });
+    g.bench_function("whole", |b| b.iter_batched(|| (), |()| whole(black_box(&v), black_box(&t), &topo, &settings), BatchSize::PerIteration));
     g.finish();
 }
 

@@ -19,7 +19,8 @@ fn main() {
         return; // `cargo test --benches` runs bench binaries with --test: nothing to do here
     }
     let n_states: usize = std::env::var("TC_PEER_STATES").ok().and_then(|s| s.parse().ok()).unwrap_or(10_000);
-    let sizes: Vec<usize> = std::env::var("TC_PEER_SIZES").ok().map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect()).unwrap_or(vec![10_000, 100_000, 1_000_000]);
+    let sizes: Vec<usize> =
+        std::env::var("TC_PEER_SIZES").ok().map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect()).unwrap_or(vec![10_000, 100_000, 1_000_000]);
     let py = python();
     let (robot, map) = panda(&py);
     let states = random_states(&robot, n_states, 1);
@@ -40,8 +41,21 @@ fn main() {
         let _ = writeln!(
             table,
             "| {} | {} | {:.3} | {:.1} | {} / {} ({:.0} %) | {ours:.2} | {:.2} | {:.2} | {coal:.2} | {fcl:.2} | {:.2} | {:.2} | {:.2} | {} / {} | {} |",
-            c.triangles, c.cells, c.build_seconds, c.memory_bytes as f64 / 1048576.0, c.ours_colliding_states, c.coal_colliding_states,
-            100.0 * c.ours_colliding_states as f64 / c.states as f64, per(c.batch_seconds), per(c.flags_seconds), ours / coal, ours / fcl, per(c.flags_seconds) / coal, c.explained_thickness, c.explained_touching, c.unexplained.len()
+            c.triangles,
+            c.cells,
+            c.build_seconds,
+            c.memory_bytes as f64 / 1048576.0,
+            c.ours_colliding_states,
+            c.coal_colliding_states,
+            100.0 * c.ours_colliding_states as f64 / c.states as f64,
+            per(c.batch_seconds),
+            per(c.flags_seconds),
+            ours / coal,
+            ours / fcl,
+            per(c.flags_seconds) / coal,
+            c.explained_thickness,
+            c.explained_touching,
+            c.unexplained.len()
         );
         for u in c.unexplained.iter().take(20) {
             eprintln!("UNEXPLAINED {u}");
@@ -52,7 +66,14 @@ fn main() {
     // The build alone at 10M triangles.
     let started = Instant::now();
     let w = world(if std::env::var_os("TC_PEER_SKIP_10M").is_some() { 1000 } else { 10_000_000 });
-    let _ = writeln!(table, "\nBuild alone at {} triangles: {:.2} s, {:.0} MiB ({} cells).", w.triangles.len(), started.elapsed().as_secs_f64(), w.memory_bytes as f64 / 1048576.0, w.scene.cell_count());
+    let _ = writeln!(
+        table,
+        "\nBuild alone at {} triangles: {:.2} s, {:.0} MiB ({} cells).",
+        w.triangles.len(),
+        started.elapsed().as_secs_f64(),
+        w.memory_bytes as f64 / 1048576.0,
+        w.scene.cell_count()
+    );
     drop(w);
     println!("{n_states} random Panda states; t = {THICKNESS} m\n\n{table}");
     std::fs::write(out.join("table.md"), &table).unwrap();
@@ -74,15 +95,35 @@ fn svg(points: &[(f64, f64, f64, f64)]) -> String {
     let px = |x: f64| m + (x.log10() - x0) / (x1 - x0) * (w - 2.0 * m);
     let py = |y: f64| h - m - (y.log10() - y0) / (y1 - y0) * (h - 2.0 * m);
     let mut s = format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n");
-    let _ = writeln!(s, "<text x=\"{}\" y=\"20\" text-anchor=\"middle\">Time per state (µs, log) against world triangles (log): Panda, 10,000 states</text>", w / 2.0);
-    let _ = writeln!(s, "<line x1=\"{m}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/><line x1=\"{m}\" y1=\"{m}\" x2=\"{m}\" y2=\"{}\" stroke=\"black\"/>", h - m, w - m, h - m, h - m);
+    let _ = writeln!(
+        s,
+        "<text x=\"{}\" y=\"20\" text-anchor=\"middle\">Time per state (µs, log) against world triangles (log): Panda, 10,000 states</text>",
+        w / 2.0
+    );
+    let _ = writeln!(
+        s,
+        "<line x1=\"{m}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/><line x1=\"{m}\" y1=\"{m}\" x2=\"{m}\" y2=\"{}\" stroke=\"black\"/>",
+        h - m,
+        w - m,
+        h - m,
+        h - m
+    );
     for p in points {
         let _ = writeln!(s, "<text x=\"{:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>", px(p.0), h - m + 16.0, p.0 as u64);
     }
     let mut e = y0;
     while e <= y1 {
         let v = 10f64.powf(e);
-        let _ = writeln!(s, "<text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text><line x1=\"{m}\" y1=\"{:.1}\" x2=\"{}\" y2=\"{:.1}\" stroke=\"#ddd\"/>", m - 4.0, py(v) + 4.0, v, py(v), w - m, py(v));
+        let _ = writeln!(
+            s,
+            "<text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text><line x1=\"{m}\" y1=\"{:.1}\" x2=\"{}\" y2=\"{:.1}\" stroke=\"#ddd\"/>",
+            m - 4.0,
+            py(v) + 4.0,
+            v,
+            py(v),
+            w - m,
+            py(v)
+        );
         e += 1.0;
     }
     for (k, (name, color)) in [("thickness_collision", "#d62728"), ("coal", "#1f77b4"), ("python-fcl", "#2ca02c")].iter().enumerate() {

@@ -45,7 +45,13 @@ pub fn random_states(robot: &RobotModel, n: usize, seed: u64) -> Vec<(Vec<String
     (0..n)
         .map(|_| {
             let names = joints.iter().map(|j| j.name.clone()).collect();
-            let pos = joints.iter().map(|j| { let (lo, hi) = (j.limits[0].max(-3.2), j.limits[1].min(3.2)); lo + (hi - lo) * rng.rand_float() }).collect();
+            let pos = joints
+                .iter()
+                .map(|j| {
+                    let (lo, hi) = (j.limits[0].max(-3.2), j.limits[1].min(3.2));
+                    lo + (hi - lo) * rng.rand_float()
+                })
+                .collect();
             (names, pos)
         })
         .collect()
@@ -74,7 +80,11 @@ pub fn world(triangles: usize) -> World {
         tris.extend(t.iter().map(|f| f.map(|i| i + base)));
     }
     let build_seconds = started.elapsed().as_secs_f64();
-    let memory_bytes = scene.objects().iter().map(|o| o.bvh_memory() + o.area().map_or(0, |a| a.cells.len() * std::mem::size_of::<thickness_collision::thickness::ThicknessCell>())).sum();
+    let memory_bytes = scene
+        .objects()
+        .iter()
+        .map(|o| o.bvh_memory() + o.area().map_or(0, |a| a.cells.len() * std::mem::size_of::<thickness_collision::thickness::ThicknessCell>()))
+        .sum();
     World { scene, vertices, triangles: tris, build_seconds, memory_bytes }
 }
 
@@ -121,7 +131,8 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
     let started = Instant::now();
     for ((names, pos), full) in states.iter().zip(&reports) {
         let flags = checker.check_joints_flags(names, pos).unwrap();
-        let (a, b): (Vec<&str>, Vec<&str>) = (flags.contacts.iter().map(|c| c.link_name.as_str()).collect(), full.contacts.iter().map(|c| c.link_name.as_str()).collect());
+        let (a, b): (Vec<&str>, Vec<&str>) =
+            (flags.contacts.iter().map(|c| c.link_name.as_str()).collect(), full.contacts.iter().map(|c| c.link_name.as_str()).collect());
         assert_eq!(a, b, "flag-only and full checks must agree on the colliding links");
     }
     let flags_seconds = started.elapsed().as_secs_f64();
@@ -167,7 +178,13 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
         for (n, p) in names.iter().zip(pos) {
             q[checker.robot().joint(n).unwrap()] = *p;
         }
-        let world_links: Vec<Pose> = checker.robot().forward_kinematics(&q, &nalgebra::Isometry3::identity()).unwrap().iter().map(thickness_collision::math::pose_from_isometry).collect();
+        let world_links: Vec<Pose> = checker
+            .robot()
+            .forward_kinematics(&q, &nalgebra::Isometry3::identity())
+            .unwrap()
+            .iter()
+            .map(thickness_collision::math::pose_from_isometry)
+            .collect();
         for (ti, _, offset) in &parts {
             let p = world_links[checker.targets()[*ti].link] * *offset;
             let m = glam::DMat3::from_quat(p.rotation);
@@ -206,11 +223,8 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
         explained_touching: 0,
         unexplained: Vec::new(),
     };
-    let trimesh = parry3d_f64::shape::TriMesh::new(
-        w.vertices.iter().map(|p| thickness_collision::math::Vector::from_array(*p)).collect(),
-        w.triangles.clone(),
-    )
-    .unwrap();
+    let trimesh =
+        parry3d_f64::shape::TriMesh::new(w.vertices.iter().map(|p| thickness_collision::math::Vector::from_array(*p)).collect(), w.triangles.clone()).unwrap();
     for peer in ["coal", "fcl"] {
         let flags = peers[peer]["flags"].as_array().unwrap();
         for (s, report) in reports.iter().enumerate() {

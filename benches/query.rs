@@ -51,7 +51,15 @@ fn bench_query(c: &mut Criterion) {
     // at 1 mm samples of its footprint against its lowest point).
     let rot = Rotation::from_axis_angle(Vector::new(1.0, 1.0, 0.0).normalize(), 0.8);
     let (cx, cy) = (3.0 + 3.0 * WAVELENGTH / 4.0, 3.0);
-    let gap_at = |z0: Real| hull.points().iter().map(|p| { let q = rot * *p; z0 + q.z - wall_height(cx + q.x, cy + q.y) }).fold(Real::INFINITY, Real::min);
+    let gap_at = |z0: Real| {
+        hull.points()
+            .iter()
+            .map(|p| {
+                let q = rot * *p;
+                z0 + q.z - wall_height(cx + q.x, cy + q.y)
+            })
+            .fold(Real::INFINITY, Real::min)
+    };
     let z_front = 0.01 - gap_at(0.0);
     let front = Target::new(TargetShape::Polytope(hull.clone()), Pose::from_parts(Vector::new(cx, cy, z_front), rot));
     let through = Target::new(TargetShape::Polytope(hull.clone()), Pose::from_parts(Vector::new(cx, cy, z_front - 0.04), rot));
@@ -60,13 +68,21 @@ fn bench_query(c: &mut Criterion) {
     let r_front = scene.collide(&front, &settings);
     let r_through = scene.collide(&through, &settings);
     eprintln!("1 cm in front: {} candidate cells, colliding {}", r_front.candidates, r_front.in_collision());
-    eprintln!("penetrating:   {} candidate cells, colliding {}, depth {:?}", r_through.candidates, r_through.in_collision(), r_through.deepest().map(|c| c.depth));
+    eprintln!(
+        "penetrating:   {} candidate cells, colliding {}, depth {:?}",
+        r_through.candidates,
+        r_through.in_collision(),
+        r_through.deepest().map(|c| c.depth)
+    );
     // The front case must give a broad phase work: the hull's world box meets the surface.
     let world_box = front.aabb_in(&front.pose);
     let under_box = t
         .iter()
         .filter(|tri| {
-            let (lo, hi) = tri.iter().map(|&i| v[i as usize]).fold((Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+            let (lo, hi) = tri
+                .iter()
+                .map(|&i| v[i as usize])
+                .fold((Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
             lo.cmple(world_box.maxs).all() && world_box.mins.cmple(hi).all()
         })
         .count();

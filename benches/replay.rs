@@ -27,13 +27,23 @@ fn write_bag(dir: &Path, states: &[(Vec<String>, Vec<f64>)]) {
     let t0: i64 = 1_700_000_000_000_000_000;
     for (k, (name, position)) in states.iter().enumerate() {
         let t = t0 + k as i64 * 1_000_000;
-        let msg = JointState { header: Header { stamp: Time::from_nanos(t), frame_id: String::new() }, name: name.clone(), position: position.clone(), velocity: vec![], effort: vec![] };
-        w.write_to_known_channel(&MessageHeader { channel_id: ch, sequence: k as u32, log_time: t as u64, publish_time: t as u64 }, &encode_cdr_le(&msg)).unwrap();
+        let msg = JointState {
+            header: Header { stamp: Time::from_nanos(t), frame_id: String::new() },
+            name: name.clone(),
+            position: position.clone(),
+            velocity: vec![],
+            effort: vec![],
+        };
+        w.write_to_known_channel(&MessageHeader { channel_id: ch, sequence: k as u32, log_time: t as u64, publish_time: t as u64 }, &encode_cdr_le(&msg))
+            .unwrap();
     }
     let _ = w.finish().unwrap();
     std::fs::write(
         dir.join("metadata.yaml"),
-        format!("rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths:\n    - bench_0.mcap\n  message_count: {}\n", states.len()),
+        format!(
+            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths:\n    - bench_0.mcap\n  message_count: {}\n",
+            states.len()
+        ),
     )
     .unwrap();
 }
@@ -45,7 +55,13 @@ fn main() {
         .map(|_| {
             let joints: Vec<_> = checker.robot().joints.iter().filter(|j| j.is_actuated()).collect();
             let names = joints.iter().map(|j| j.name.clone()).collect();
-            let pos = joints.iter().map(|j| { let (lo, hi) = (j.limits[0].max(-3.0), j.limits[1].min(3.0)); lo + (hi - lo) * rng.rand_float() }).collect();
+            let pos = joints
+                .iter()
+                .map(|j| {
+                    let (lo, hi) = (j.limits[0].max(-3.0), j.limits[1].min(3.0));
+                    lo + (hi - lo) * rng.rand_float()
+                })
+                .collect();
             (names, pos)
         })
         .collect();

@@ -18,15 +18,7 @@ pub fn wall(nx: usize, ny: usize) -> generate::Soup {
 /// Over the flattened arrays, `sum_k bits(coord_k) * (2k + 1)` and `sum_k index_k * (2k + 1)`,
 /// both wrapping mod 2^64 (`benches/coal_build.py` recomputes it).
 pub fn checksum(v: &[Vector], t: &[[u32; 3]]) -> (u64, u64) {
-    let cv = v
-        .iter()
-        .flat_map(|p| [p.x, p.y, p.z])
-        .enumerate()
-        .fold(0u64, |s, (k, x)| s.wrapping_add(x.to_bits().wrapping_mul(2 * k as u64 + 1)));
-    let ct = t
-        .iter()
-        .flatten()
-        .enumerate()
-        .fold(0u64, |s, (k, &i)| s.wrapping_add((i as u64).wrapping_mul(2 * k as u64 + 1)));
+    let cv = v.iter().flat_map(|p| [p.x, p.y, p.z]).enumerate().fold(0u64, |s, (k, x)| s.wrapping_add(x.to_bits().wrapping_mul(2 * k as u64 + 1)));
+    let ct = t.iter().flatten().enumerate().fold(0u64, |s, (k, &i)| s.wrapping_add((i as u64).wrapping_mul(2 * k as u64 + 1)));
     (cv, ct)
 }

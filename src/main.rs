@@ -146,4 +146,3 @@ fn run(cli: Cli) -> Result<()> {
         }
     }
 }
-

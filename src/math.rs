@@ -49,4 +49,3 @@ pub fn pose_from_isometry(iso: &nalgebra::Isometry3<Real>) -> Pose {
     let t = iso.translation.vector;
     Pose::from_parts(Vector::new(t.x, t.y, t.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w))
 }
-

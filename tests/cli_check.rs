@@ -46,8 +46,10 @@ fn json_lines_agree_across_input_forms_and_runs() {
     std::fs::write(
         &states,
         concat!(
-            r#"{"name": ["shoulder_pan_joint", "other_robot_joint"], "position": [0.0, 1.0]}"#, "\n",
-            r#"{"name": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"], "position": [0, 1.2, 0.3]}"#, "\n",
+            r#"{"name": ["shoulder_pan_joint", "other_robot_joint"], "position": [0.0, 1.0]}"#,
+            "\n",
+            r#"{"name": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"], "position": [0, 1.2, 0.3]}"#,
+            "\n",
         ),
     )
     .unwrap();
@@ -84,7 +86,8 @@ fn thickness_and_side_override_the_parameters() {
     let params = tmp("wrist_only.yaml");
     std::fs::write(&params, "thickness_collision:\n  ros__parameters:\n    checked_links: [wrist_1_link]\n").unwrap();
     let hit = |extra: &[&str]| -> bool {
-        let out = ok(bin().args(["check", "--params-file", params.to_str().unwrap(), "--states", states.to_str().unwrap(), "--json"]).args(extra).output().unwrap());
+        let out =
+            ok(bin().args(["check", "--params-file", params.to_str().unwrap(), "--states", states.to_str().unwrap(), "--json"]).args(extra).output().unwrap());
         serde_json::from_str::<serde_json::Value>(out.trim()).unwrap()["in_collision"].as_bool().unwrap()
     };
     assert!(hit(&[]), "default 2 cm reaches it");
@@ -110,11 +113,24 @@ fn bad_input_is_a_clear_error() {
     err(bin().args(["check", "--robot", bad_xml.to_str().unwrap(), "--joints", "a=0"]).output().unwrap(), &["bad.urdf", "malformed"]);
     // Unknown package.
     let pkg = tmp("pkg.urdf");
-    std::fs::write(&pkg, r#"<robot name="x"><link name="a"><collision><geometry><mesh filename="package://no_such_pkg/m.stl"/></geometry></collision></link></robot>"#).unwrap();
-    err(bin().args(["check", "--robot", pkg.to_str().unwrap(), "--joints", "a=0"]).env("AMENT_PREFIX_PATH", "/nonexistent_prefix").env_remove("ROS_PACKAGE_PATH").output().unwrap(), &["package://no_such_pkg/m.stl", "'no_such_pkg'", "/nonexistent_prefix/share/no_such_pkg"]);
+    std::fs::write(
+        &pkg,
+        r#"<robot name="x"><link name="a"><collision><geometry><mesh filename="package://no_such_pkg/m.stl"/></geometry></collision></link></robot>"#,
+    )
+    .unwrap();
+    err(
+        bin()
+            .args(["check", "--robot", pkg.to_str().unwrap(), "--joints", "a=0"])
+            .env("AMENT_PREFIX_PATH", "/nonexistent_prefix")
+            .env_remove("ROS_PACKAGE_PATH")
+            .output()
+            .unwrap(),
+        &["package://no_such_pkg/m.stl", "'no_such_pkg'", "/nonexistent_prefix/share/no_such_pkg"],
+    );
     // Missing mesh file.
     let missing = tmp("missing.urdf");
-    std::fs::write(&missing, r#"<robot name="x"><link name="a"><collision><geometry><mesh filename="nowhere.stl"/></geometry></collision></link></robot>"#).unwrap();
+    std::fs::write(&missing, r#"<robot name="x"><link name="a"><collision><geometry><mesh filename="nowhere.stl"/></geometry></collision></link></robot>"#)
+        .unwrap();
     err(bin().args(["check", "--robot", missing.to_str().unwrap(), "--joints", "a=0"]).output().unwrap(), &["link 'a'", "nowhere.stl"]);
     // A mesh with NaN.
     std::fs::write(tmp("nan.obj"), "v 0 0 0\nv 1 nan 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n").unwrap();

@@ -109,12 +109,24 @@ fn pruned_queries_agree_with_brute_force() {
                     let max = truth.iter().map(|(_, d)| *d).fold(Real::NEG_INFINITY, Real::max);
                     assert!((c.depth - max).abs() <= 1e-9, "deepest {} vs brute force {max}: {context}", c.depth);
                     let own = truth.iter().find(|(tri, _)| *tri == c.triangle);
-                    assert!(own.is_some_and(|(_, d)| (*d - c.depth).abs() <= 1e-12), "the reported cell {} must collide at the reported depth {}, brute force {own:?}: {context}", c.triangle, c.depth);
-                    assert!(c.least.is_some_and(|l| l.overlap > 0.0 && l.axis.is_finite()) && c.position.is_some_and(|p| p.is_finite()), "least overlap and point: {context}");
+                    assert!(
+                        own.is_some_and(|(_, d)| (*d - c.depth).abs() <= 1e-12),
+                        "the reported cell {} must collide at the reported depth {}, brute force {own:?}: {context}",
+                        c.triangle,
+                        c.depth
+                    );
+                    assert!(
+                        c.least.is_some_and(|l| l.overlap > 0.0 && l.axis.is_finite()) && c.position.is_some_and(|p| p.is_finite()),
+                        "least overlap and point: {context}"
+                    );
                 }
                 // Without the least overlap the same contact (its least overlap may be left out).
                 let lean = scene.collide(&target, &CollideSettings { least_overlap: false, ..Default::default() });
-                assert_eq!(lean.deepest().map(|c| (c.triangle, c.depth, c.position)), deepest.deepest().map(|c| (c.triangle, c.depth, c.position)), "{context}");
+                assert_eq!(
+                    lean.deepest().map(|c| (c.triangle, c.depth, c.position)),
+                    deepest.deepest().map(|c| (c.triangle, c.depth, c.position)),
+                    "{context}"
+                );
 
                 let all = scene.collide(&target, &CollideSettings { all_contacts: true, ..Default::default() });
                 let mut got: Vec<u32> = all.contacts.iter().map(|c| c.triangle).collect();
@@ -154,7 +166,11 @@ fn hull_support_matches_a_scan() {
         let pts: Vec<Vector> = (0..n)
             .map(|_| {
                 let p = rng.unit() * axes * if rng.f() < 0.2 { rng.f() } else { 1.0 };
-                if rng.f() < 0.1 { p.with_z(axes.z) } else { p }
+                if rng.f() < 0.1 {
+                    p.with_z(axes.z)
+                } else {
+                    p
+                }
             })
             .collect();
         let Some(hull) = ConvexHull::from_points(&pts) else { continue };
@@ -168,7 +184,12 @@ fn hull_support_matches_a_scan() {
             for (k, axis) in [Vector::X, Vector::Y, Vector::Z].into_iter().enumerate() {
                 let d = inv * axis;
                 let (lo, hi) = hull.points().iter().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), p| (lo.min(d.dot(*p)), hi.max(d.dot(*p))));
-                assert!((aabb.mins[k] - lo).abs() <= 1e-12 && (aabb.maxs[k] - hi).abs() <= 1e-12, "axis {k}: [{}, {}] vs scan [{lo}, {hi}]", aabb.mins[k], aabb.maxs[k]);
+                assert!(
+                    (aabb.mins[k] - lo).abs() <= 1e-12 && (aabb.maxs[k] - hi).abs() <= 1e-12,
+                    "axis {k}: [{}, {}] vs scan [{lo}, {hi}]",
+                    aabb.mins[k],
+                    aabb.maxs[k]
+                );
             }
         }
     }

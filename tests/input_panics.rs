@@ -2,7 +2,7 @@
 
 use std::process::Command;
 use thickness_collision::checker::{Checker, CheckerError};
-use thickness_collision::model::{bundled_config_dir, Params, PackageResolver, PositionsError, RobotModel};
+use thickness_collision::model::{bundled_config_dir, PackageResolver, Params, PositionsError, RobotModel};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_thickness_collision"))

@@ -22,8 +22,8 @@ fn real_robots_load_and_every_link_gets_targets() {
     for rel in [
         "panda_description/urdf/panda.urdf",
         "ur_description/urdf/ur5_robot.urdf",
-        "solo_description/robots/solo12.urdf",     // STL with a `solid` header
-        "talos_data/robots/talos_full_v2.urdf",    // negative mesh scales
+        "solo_description/robots/solo12.urdf",  // STL with a `solid` header
+        "talos_data/robots/talos_full_v2.urdf", // negative mesh scales
     ] {
         let (checker, _, _) = load(rel);
         let with_geometry: Vec<&str> = checker.robot().links.iter().filter(|l| !l.geometry.is_empty()).map(|l| l.name.as_str()).collect();
@@ -40,7 +40,9 @@ fn real_robots_load_and_every_link_gets_targets() {
 fn solo12_binary_stl_with_solid_header_is_read() {
     let (checker, _, _) = load("solo_description/robots/solo12.urdf");
     let header_is_solid = checker.robot().links.iter().flat_map(|l| &l.geometry).any(|g| match &g.spec {
-        thickness_collision::model::GeometrySpec::Mesh { path, .. } => std::fs::read(path).map(|b| b.starts_with(b"solid") && b.len() == 84 + 50 * u32::from_le_bytes([b[80], b[81], b[82], b[83]]) as usize).unwrap_or(false),
+        thickness_collision::model::GeometrySpec::Mesh { path, .. } => std::fs::read(path)
+            .map(|b| b.starts_with(b"solid") && b.len() == 84 + 50 * u32::from_le_bytes([b[80], b[81], b[82], b[83]]) as usize)
+            .unwrap_or(false),
         _ => false,
     });
     assert!(header_is_solid, "the fixture no longer has a binary STL starting with `solid`");
@@ -49,7 +51,13 @@ fn solo12_binary_stl_with_solid_header_is_read() {
 #[test]
 fn talos_negative_scales_are_mirrored() {
     let (checker, _, _) = load("talos_data/robots/talos_full_v2.urdf");
-    let mirrored = checker.robot().links.iter().flat_map(|l| &l.geometry).filter(|g| matches!(&g.spec, thickness_collision::model::GeometrySpec::Mesh { scale, .. } if scale.iter().product::<f64>() < 0.0)).count();
+    let mirrored = checker
+        .robot()
+        .links
+        .iter()
+        .flat_map(|l| &l.geometry)
+        .filter(|g| matches!(&g.spec, thickness_collision::model::GeometrySpec::Mesh { scale, .. } if scale.iter().product::<f64>() < 0.0))
+        .count();
     assert!(mirrored > 0);
 }
 

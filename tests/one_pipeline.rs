@@ -185,7 +185,8 @@ fn replayed(messages: &[Value], params: &Path, d: &Path, storage: &str) -> (Vec<
     let _ = peer(&json!({"op": "bag", "path": bag, "storage": storage, "messages": messages}), None);
     let jsonl = d.join(format!("out_{storage}.jsonl"));
     let topic = if messages.iter().any(|m| m["topic"] == "/tf") { "/tf" } else { "/joint_states" };
-    let o = bin().arg("replay").arg(&bag).args(["--params-file", params.to_str().unwrap(), "--topic", topic, "--jsonl", jsonl.to_str().unwrap()]).output().unwrap();
+    let o =
+        bin().arg("replay").arg(&bag).args(["--params-file", params.to_str().unwrap(), "--topic", topic, "--jsonl", jsonl.to_str().unwrap()]).output().unwrap();
     let summary = String::from_utf8_lossy(&o.stdout).to_string();
     assert!(o.status.success(), "replay: {}\n{summary}", String::from_utf8_lossy(&o.stderr));
     let mut skips = BTreeMap::new();

@@ -18,7 +18,13 @@ fn no_unexplained_disagreement_with_coal_and_fcl() {
     let c = compare(&py, &robot, &map, &states, 10_000, &dir);
     eprintln!(
         "{} triangles, {} states: ours colliding {}, coal {}; explained by thickness {}, by touching {}; unexplained {}",
-        c.triangles, c.states, c.ours_colliding_states, c.coal_colliding_states, c.explained_thickness, c.explained_touching, c.unexplained.len()
+        c.triangles,
+        c.states,
+        c.ours_colliding_states,
+        c.coal_colliding_states,
+        c.explained_thickness,
+        c.explained_touching,
+        c.unexplained.len()
     );
     for u in &c.unexplained {
         eprintln!("  {u}");

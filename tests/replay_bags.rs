@@ -48,7 +48,11 @@ fn states(n: usize, seed: u64) -> Vec<(Vec<String>, Vec<f64>)> {
 const T0: i64 = 1_700_000_000_000_000_000;
 
 fn joint_messages(states: &[(Vec<String>, Vec<f64>)]) -> Vec<Value> {
-    states.iter().enumerate().map(|(k, (n, p))| json!({"t": T0 + k as i64 * 10_000_000, "stamp": T0 + k as i64 * 10_000_000 - 1234, "name": n, "position": p})).collect()
+    states
+        .iter()
+        .enumerate()
+        .map(|(k, (n, p))| json!({"t": T0 + k as i64 * 10_000_000, "stamp": T0 + k as i64 * 10_000_000 - 1234, "name": n, "position": p}))
+        .collect()
 }
 
 /// `check --states` lines for the states of [`joint_messages`], with the same stamps.

@@ -38,7 +38,14 @@ fn start_node(args: &[&str], domain: u32) -> (std::process::Child, BufReader<std
 /// Runs the Cyclone DDS peer with a loopback-only configuration; returns its JSON answer.
 fn run_dds_peer(cyclone: &std::path::Path, request: &Value) -> Value {
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
-    let mut child = Command::new(common::python()).arg(&path).env("CYCLONEDDS_URI", format!("file://{}", cyclone.display())).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let mut child = Command::new(common::python())
+        .arg(&path)
+        .env("CYCLONEDDS_URI", format!("file://{}", cyclone.display()))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
     {
         use std::io::Write;
         child.stdin.take().unwrap().write_all(request.to_string().replace("\"NaN\"", "NaN").as_bytes()).unwrap();
@@ -75,7 +82,10 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     // The node's parameters after the set below: default_thickness 0.2, the rest as in the file.
     let after = dir.join("params_after.yaml");
     std::fs::write(&after, std::fs::read_to_string(&params).unwrap().replace("default_thickness: 0.02", "default_thickness: 0.2")).unwrap();
-    let reference = Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--params-file", after.to_str().unwrap(), "--states", file.to_str().unwrap(), "--json"]).output().unwrap();
+    let reference = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+        .args(["check", "--params-file", after.to_str().unwrap(), "--states", file.to_str().unwrap(), "--json"])
+        .output()
+        .unwrap();
     assert!(reference.status.success());
     let reference: Vec<Value> = String::from_utf8(reference.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert!(reference.iter().any(|r| r["in_collision"] == true) && reference.iter().any(|r| r["in_collision"] == false));
@@ -197,7 +207,22 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     let cyclone = dir.join("cyclone.xml");
     std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
     let domain = 150 + std::process::id() % 50;
-    let (mut node, _out, banner) = start_node(&["--ros-args", "-r", "__ns:=/robot1", "-p", "pose_source:=tf", "-p", "frame_prefix:=robot1/", "-p", "use_sim_time:=true", "-p", "service_mapping:=enhanced"], domain);
+    let (mut node, _out, banner) = start_node(
+        &[
+            "--ros-args",
+            "-r",
+            "__ns:=/robot1",
+            "-p",
+            "pose_source:=tf",
+            "-p",
+            "frame_prefix:=robot1/",
+            "-p",
+            "use_sim_time:=true",
+            "-p",
+            "service_mapping:=enhanced",
+        ],
+        domain,
+    );
     assert!(banner.contains("/robot1/thickness_collision") && banner.contains("/tf"), "{banner}");
 
     // Link poses from forward kinematics, sent as world -> robot1/<link> transforms.

@@ -45,9 +45,9 @@ fn rotation(rng: &mut Rand64) -> Rotation {
 fn cell_pool() -> Vec<(ThicknessCell, Side)> {
     let mut pool = Vec::new();
     let meshes: Vec<(generate::Soup, Real)> = vec![
-        (generate::uv_sphere(0.1, 8, 12), 0.05),      // tetrahedra (t above apex height)
-        (generate::uv_sphere(0.3, 10, 16), 0.02),     // ratioed
-        (generate::flat_grid(4, 4, 0.2, 0.2), 0.01),  // prisms
+        (generate::uv_sphere(0.1, 8, 12), 0.05),          // tetrahedra (t above apex height)
+        (generate::uv_sphere(0.3, 10, 16), 0.02),         // ratioed
+        (generate::flat_grid(4, 4, 0.2, 0.2), 0.01),      // prisms
         (generate::v_fold(1.0, true, 0.1, 0.2, 3), 0.02), // diverging and converging
         (generate::v_fold(2.2, false, 0.1, 0.2, 3), 0.02),
         (generate::wavy_sheet(8, 8, 0.4, 0.4, 0.03, 0.2), 0.015),

@@ -40,9 +40,9 @@
 mod shapes;
 
 use oorandom::Rand64;
-use shapes::{aabb_of, fan_fold, segment_crosses_triangle};
 use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use shapes::{aabb_of, fan_fold, segment_crosses_triangle};
 use std::f64::consts::PI;
 use std::time::Instant;
 use thickness_collision::math::{Aabb, Pose, Real, Rotation, Vector};
@@ -70,7 +70,6 @@ fn random_pose(rng: &mut Rand64) -> Pose {
     let shift = Vector::new(uniform(rng, -3., 3.), uniform(rng, -3., 3.), uniform(rng, -3., 3.));
     Pose::from_parts(shift, Rotation::from_axis_angle(axis, uniform(rng, 0.0, 2.0 * PI)))
 }
-
 
 fn aabb_around(p: Vector, r: Real) -> Aabb {
     Aabb::new(p - Vector::splat(r), p + Vector::splat(r))
@@ -123,7 +122,6 @@ fn closest_on_triangle(p: Vector, [a, b, c]: [Vector; 3]) -> (Vector, Feature) {
     let denom = 1.0 / (va + vb + vc);
     (a + ab * (vb * denom) + ac * (vc * denom), Feature::Face)
 }
-
 
 /// Solves `m x = r` by Gaussian elimination with partial pivoting; also returns `|det m|`
 /// (rows are unit vectors here, so it measures how far from parallel the planes are).
@@ -200,7 +198,6 @@ fn jitter_in_plane(soup: Soup, nx: usize, ny: usize, sx: Real, sy: Real, amount:
     (v, t)
 }
 
-
 fn cases() -> Vec<Case> {
     let mut rng = Rand64::new(0x5eed_0001);
     let mut out: Vec<Case> = Vec::new();
@@ -234,7 +231,9 @@ fn cases() -> Vec<Case> {
     }
     // t below the radius (half the diameter); the thick ones are there for the tetrahedra, and
     // their vertex radii t / sin(a/2) cover nearly everything.
-    for (r, rings, segs, t, min) in [(0.1, 10, 16, 0.008, 0.25), (0.1, 12, 20, 0.005, 0.25), (0.1, 8, 12, 0.05, 0.01), (0.1, 6, 8, 0.09, 0.0), (0.5, 12, 20, 0.45, 0.0)] {
+    for (r, rings, segs, t, min) in
+        [(0.1, 10, 16, 0.008, 0.25), (0.1, 12, 20, 0.005, 0.25), (0.1, 8, 12, 0.05, 0.01), (0.1, 6, 8, 0.09, 0.0), (0.5, 12, 20, 0.45, 0.0)]
+    {
         add(format!("sphere r={r} {rings}x{segs} t={t}"), Family::Sphere, generate::uv_sphere(r, rings, segs), t, min);
     }
     // Half-sizes 0.2, 0.3, 0.25: t below the smallest.
@@ -383,23 +382,7 @@ fn build_probe(soup: &Soup, t: Real, side: Side, walls: WallRule) -> Probe {
     let sharp_bvh = leaves(sharp_edges.iter().map(|&(a, b, r)| aabb_of(&[a, b]).loosened(r)).collect());
     let vertex_pn = vertex_pn.into_iter().map(|n| n.normalize()).collect();
     let eps = 1e-9 * mesh.size;
-    Probe {
-        mesh,
-        area,
-        t,
-        eps,
-        cell_bvh,
-        tri_bvh,
-        free_edges,
-        free_bvh,
-        vertex_radius,
-        on_free_edge,
-        vertex_bvh,
-        sharp_edges,
-        sharp_bvh,
-        vertex_pn,
-        edge_pn,
-    }
+    Probe { mesh, area, t, eps, cell_bvh, tri_bvh, free_edges, free_bvh, vertex_radius, on_free_edge, vertex_bvh, sharp_edges, sharp_bvh, vertex_pn, edge_pn }
 }
 
 impl Probe {
@@ -428,15 +411,14 @@ impl Probe {
     /// The cells that hold `x` strictly (by `eps`).
     fn holders(&self, x: Vector) -> Vec<usize> {
         let q = aabb_around(x, self.eps);
-        let holders = self.cell_bvh.intersect_aabb(&q).map(|k| k as usize).filter(|&k| k < self.faces() && self.area.cells[k].contains_point(x, -self.eps)).collect();
+        let holders =
+            self.cell_bvh.intersect_aabb(&q).map(|k| k as usize).filter(|&k| k < self.faces() && self.area.cells[k].contains_point(x, -self.eps)).collect();
         holders
     }
 
     fn near_free_edge(&self, x: Vector) -> bool {
         let q = aabb_around(x, 0.0);
-        let near = self.free_bvh.intersect_aabb(&q).any(|k| {
-            self.free_edges.get(k as usize).is_some_and(|&(a, b)| dist_to_segment(x, a, b) <= 2.0 * self.t)
-        });
+        let near = self.free_bvh.intersect_aabb(&q).any(|k| self.free_edges.get(k as usize).is_some_and(|&(a, b)| dist_to_segment(x, a, b) <= 2.0 * self.t));
         near
     }
 
@@ -452,9 +434,7 @@ impl Probe {
 
     fn near_sharp_edge(&self, x: Vector) -> bool {
         let q = aabb_around(x, 0.0);
-        let near = self.sharp_bvh.intersect_aabb(&q).any(|k| {
-            self.sharp_edges.get(k as usize).is_some_and(|&(a, b, r)| dist_to_segment(x, a, b) <= r)
-        });
+        let near = self.sharp_bvh.intersect_aabb(&q).any(|k| self.sharp_edges.get(k as usize).is_some_and(|&(a, b, r)| dist_to_segment(x, a, b) <= r));
         near
     }
 
@@ -822,8 +802,13 @@ fn check_rule(p: &Probe, side: Side, name: &str) -> KindCount {
             Side::Both => &[-1.0, 1.0],
         };
         // Per side: height of the cross point on that side, expected kind, kinds allowed.
-        let per_side: Vec<(Real, Option<Real>, CellKind, Vec<CellKind>)> =
-            sides.iter().map(|&s| { let h = h_front.map(|h| s * h); (s, h, expected_kind(h, t), allowed(h)) }).collect();
+        let per_side: Vec<(Real, Option<Real>, CellKind, Vec<CellKind>)> = sides
+            .iter()
+            .map(|&s| {
+                let h = h_front.map(|h| s * h);
+                (s, h, expected_kind(h, t), allowed(h))
+            })
+            .collect();
         // The kind the cell reports (design: for `both`, the converging side names it).
         let name_of = |kb: CellKind, kf: CellKind| if kb == CellKind::Diverging { kf } else { kb };
         let (want, ok) = match side {
@@ -884,7 +869,11 @@ fn check_rule(p: &Probe, side: Side, name: &str) -> KindCount {
                 if h < 1e3 * size {
                     for i in 0..3 {
                         let want = c[i] + (apex - c[i]) * (t / h);
-                        assert!(cap[i].distance(want) < tol * (1.0 + h / size), "{name}: face {f}: ratioed vertex {i} {:?} vs v + (c - v) t/h = {want:?}", cap[i]);
+                        assert!(
+                            cap[i].distance(want) < tol * (1.0 + h / size),
+                            "{name}: face {f}: ratioed vertex {i} {:?} vs v + (c - v) t/h = {want:?}",
+                            cap[i]
+                        );
                     }
                     count.ratio_checked += 1;
                 }
@@ -908,7 +897,13 @@ fn check_transform(base: &ThicknessArea, moved: &ThicknessArea, pose: &Pose, siz
         assert_eq!(a.triangle, b.triangle);
         assert!((pose.rotation * a.normal - b.normal).length() < 1e-12, "{name}: normal of triangle {}", a.triangle);
         for (p, q) in a.vertices().iter().zip(b.vertices()) {
-            assert!((pose * *p).distance(q) < tol, "{name}: triangle {}: cell vertex {:?} moved is {:?}, built on the moved mesh {q:?}", a.triangle, pose * *p, q);
+            assert!(
+                (pose * *p).distance(q) < tol,
+                "{name}: triangle {}: cell vertex {:?} moved is {:?}, built on the moved mesh {q:?}",
+                a.triangle,
+                pose * *p,
+                q
+            );
         }
         assert!(kinds_close(a.kind, b.kind) || a.kind == b.kind, "{name}: kind {:?} vs {:?}", a.kind, b.kind);
     }
@@ -1090,13 +1085,21 @@ fn front_and_both_sides() {
             for i in 0..3 {
                 let (wb, wf) = (b.planes()[2 + i], fr.planes()[2 + i]);
                 for q in [b.back_cap[i], b.back_cap[(i + 1) % 3], fr.front_cap[i], fr.front_cap[(i + 1) % 3]] {
-                    assert!((wb.0.dot(q) - wb.1).abs() < tol && (wf.0.dot(q) - wf.1).abs() < tol, "{}: face {f}: wall {i} differs between back and front", case.name);
+                    assert!(
+                        (wb.0.dot(q) - wb.1).abs() < tol && (wf.0.dot(q) - wf.1).abs() < tol,
+                        "{}: face {f}: wall {i} differs between back and front",
+                        case.name
+                    );
                 }
                 assert!(wb.0.dot(wf.0) > 1.0 - 1e-9, "{}: face {f}: wall {i} turned", case.name);
             }
             // Both spans both: its caps are the back cell's back cap and the front cell's front cap.
             for i in 0..3 {
-                assert!(o.back_cap[i].distance(b.back_cap[i]) < tol && o.front_cap[i].distance(fr.front_cap[i]) < tol, "{}: face {f}: both != back + front", case.name);
+                assert!(
+                    o.back_cap[i].distance(b.back_cap[i]) < tol && o.front_cap[i].distance(fr.front_cap[i]) < tol,
+                    "{}: face {f}: both != back + front",
+                    case.name
+                );
             }
             let [lo, hi] = o.normal_range();
             assert!((lo - b.normal_range()[0]).abs() < tol && (hi - fr.normal_range()[1]).abs() < tol);
@@ -1136,7 +1139,9 @@ fn front_and_both_sides() {
 #[test]
 fn topology_reports_winding_and_edges() {
     let mut rng = Rand64::new(0x5eed_0004);
-    for case in cases().iter().filter(|c| matches!(c.family, Family::WrongWay | Family::NonManifold | Family::Holed | Family::Sphere | Family::Cuboid | Family::VFold)) {
+    for case in
+        cases().iter().filter(|c| matches!(c.family, Family::WrongWay | Family::NonManifold | Family::Holed | Family::Sphere | Family::Cuboid | Family::VFold))
+    {
         let pose = random_pose(&mut rng);
         let soup = generate::transformed(case.soup.clone(), &pose);
         let p = build_probe(&soup, case.t, Side::Back, WallRule::Shared);
@@ -1232,14 +1237,32 @@ fn gap_and_overlap_volume_fractions() {
     let crest = |a: Real, w: Real| 1.0 / (a * (2.0 * PI / w).powi(2));
     let meshes: Vec<(&str, Soup, Real, Real, Real)> = vec![
         ("wavy a=0.05 w=0.5, t=0.02", generate::wavy_sheet(16, 16, 1.0, 1.0, 0.05, 0.5), 0.02, crest(0.05, 0.5), 2.0),
-        ("wavy a=0.03 w=0.4 jittered, t=0.01", jitter_in_plane(generate::wavy_sheet(20, 20, 1.0, 1.0, 0.03, 0.4), 20, 20, 1.0, 1.0, 0.3, &mut jitter_rng), 0.01, crest(0.03, 0.4), 2.0),
-        ("wavy a=0.08 w=0.3 jittered, t=0.015", jitter_in_plane(generate::wavy_sheet(16, 16, 1.0, 1.0, 0.08, 0.3), 16, 16, 1.0, 1.0, 0.3, &mut jitter_rng), 0.015, crest(0.08, 0.3), 2.0),
+        (
+            "wavy a=0.03 w=0.4 jittered, t=0.01",
+            jitter_in_plane(generate::wavy_sheet(20, 20, 1.0, 1.0, 0.03, 0.4), 20, 20, 1.0, 1.0, 0.3, &mut jitter_rng),
+            0.01,
+            crest(0.03, 0.4),
+            2.0,
+        ),
+        (
+            "wavy a=0.08 w=0.3 jittered, t=0.015",
+            jitter_in_plane(generate::wavy_sheet(16, 16, 1.0, 1.0, 0.08, 0.3), 16, 16, 1.0, 1.0, 0.3, &mut jitter_rng),
+            0.015,
+            crest(0.08, 0.3),
+            2.0,
+        ),
         ("sphere r=0.1 12x18, t=0.02", generate::uv_sphere(0.1, 12, 18), 0.02, 0.1, 2.0),
         ("sphere r=0.1 8x12, t=0.05", generate::uv_sphere(0.1, 8, 12), 0.05, 0.1, 2.0),
         ("saddle k=0.6, t=0.02", generate::saddle(16, 1.0, 0.6), 0.02, 1.0 / 1.2, 2.0),
         ("saddle k=1.0, t=0.03", generate::saddle(12, 1.0, 1.0), 0.03, 0.5, 2.0),
         ("box 3x3 per side, t=0.03", generate::cuboid(Vector::new(0.2, 0.3, 0.25), 3), 0.03, Real::INFINITY, 2.0),
-        ("thick: wavy a=0.08 w=0.3 jit., t=0.03", jitter_in_plane(generate::wavy_sheet(16, 16, 1.0, 1.0, 0.08, 0.3), 16, 16, 1.0, 1.0, 0.3, &mut jitter_rng), 0.03, crest(0.08, 0.3), 10.0),
+        (
+            "thick: wavy a=0.08 w=0.3 jit., t=0.03",
+            jitter_in_plane(generate::wavy_sheet(16, 16, 1.0, 1.0, 0.08, 0.3), 16, 16, 1.0, 1.0, 0.3, &mut jitter_rng),
+            0.03,
+            crest(0.08, 0.3),
+            10.0,
+        ),
         ("thick: box 2x2 per side, t=0.15", generate::cuboid(Vector::new(0.2, 0.3, 0.25), 2), 0.15, Real::INFINITY, 20.0),
     ];
     eprintln!("gap / overlap volume fractions of the true thickness region behind the surface (side = back): points uniform in volume within t");
@@ -1282,7 +1305,10 @@ fn shared_walls_against_naive_prisms_on_v_folds() {
     eprintln!("cells' side, >= 2t from the boundary edges and outside the vertex radii of the strip ends; interior crease vertices NOT excluded.");
     eprintln!("fan fold: every face touching the crease has an edge on it; v_fold (generate::v_fold): some faces touch the crease at one vertex only.");
     eprintln!("'far' = shared walls, only the points outside every vertex radius t/sin(a/2).");
-    eprintln!("{:<22} {:<6} {:<8} {:>6} | {:>7} {:>9} | {:>6} {:>7} {:>9} | {:>7} {:>9}", "fold", "side", "that is", "points", "gap %", "overlap %", "far", "gap %", "overlap %", "gap %", "overlap %");
+    eprintln!(
+        "{:<22} {:<6} {:<8} {:>6} | {:>7} {:>9} | {:>6} {:>7} {:>9} | {:>7} {:>9}",
+        "fold", "side", "that is", "points", "gap %", "overlap %", "far", "gap %", "overlap %", "gap %", "overlap %"
+    );
     eprintln!("{:<22} {:<6} {:<8} {:>6} | {:>17} | {:>24} | {:>17}", "", "", "", "", "shared walls", "shared walls, far", "naive prisms");
     for deg in [60, 90, 120, 150] {
         for ridge in [true, false] {

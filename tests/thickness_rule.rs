@@ -16,9 +16,9 @@
 mod shapes;
 
 use oorandom::Rand64;
-use shapes::{aabb_of, fan_fold, segment_crosses_triangle};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use shapes::{aabb_of, fan_fold, segment_crosses_triangle};
 use std::f64::consts::PI;
 use thickness_collision::math::{Pose, Real, Rotation, Vector};
 use thickness_collision::mesh::generate::{self, Soup};
@@ -78,7 +78,13 @@ fn cases() -> Vec<Case> {
     }
     for k in 0..10 {
         let (a, w) = (rf(&mut rng, 0.01, 0.08), rf(&mut rng, 0.3, 0.8));
-        add(format!("wavy sheet {k} (amplitude {a:.3}, wavelength {w:.2})"), generate::wavy_sheet(16, 16, 1.0, 1.0, a, w), rf(&mut rng, 0.005, 0.03), false, None);
+        add(
+            format!("wavy sheet {k} (amplitude {a:.3}, wavelength {w:.2})"),
+            generate::wavy_sheet(16, 16, 1.0, 1.0, a, w),
+            rf(&mut rng, 0.005, 0.03),
+            false,
+            None,
+        );
     }
     for deg in [30, 45, 60, 75, 90, 105, 120, 135, 150, 165, 175] {
         for ridge in [true, false] {
@@ -112,7 +118,9 @@ fn cases() -> Vec<Case> {
         t.push([b, a, top + 1]);
         add("non-manifold fan".into(), (v, t), 0.02, false, None);
     }
-    for (k, (name, soup)) in [("grid", generate::flat_grid(8, 8, 1.0, 1.0)), ("wavy", generate::wavy_sheet(12, 12, 1.0, 1.0, 0.04, 0.6))].into_iter().enumerate() {
+    for (k, (name, soup)) in
+        [("grid", generate::flat_grid(8, 8, 1.0, 1.0)), ("wavy", generate::wavy_sheet(12, 12, 1.0, 1.0, 0.04, 0.6))].into_iter().enumerate()
+    {
         let (v, mut t) = soup;
         t[40 + k].swap(1, 2);
         add(format!("{name} with one face wound the wrong way"), (v, t), 0.02, k == 0, None);
@@ -134,7 +142,6 @@ struct Built {
     vertex_radius: Vec<Real>,
     t: Real,
 }
-
 
 fn build(soup: &Soup, t: Real, side: Side, walls: WallRule) -> Built {
     let mesh = MeshTopology::build(&soup.0, &soup.1, &TopologySettings::default()).unwrap();
@@ -186,7 +193,6 @@ fn dist_point_triangle(p: Vector, [a, b, c]: [Vector; 3]) -> Real {
     dist_point_segment(p, a, b).min(dist_point_segment(p, b, c)).min(dist_point_segment(p, c, a))
 }
 
-
 impl Built {
     /// Cells holding `x`: (with the planes pushed out by eps, strictly inside by eps).
     fn count_cells(&self, x: Vector) -> (usize, usize) {
@@ -217,7 +223,13 @@ impl Built {
     fn foreign_face_near(&self, f: usize, x: Vector) -> bool {
         let t = self.t;
         let q = Aabb::new(x - Vector::splat(t), x + Vector::splat(t));
-        let neighbours: Vec<usize> = self.mesh.links[f].iter().filter_map(|l| match l { EdgeLink::Shared { face, .. } => Some(*face as usize), _ => None }).collect();
+        let neighbours: Vec<usize> = self.mesh.links[f]
+            .iter()
+            .filter_map(|l| match l {
+                EdgeLink::Shared { face, .. } => Some(*face as usize),
+                _ => None,
+            })
+            .collect();
         let near = self.tri_bvh.intersect_aabb(&q).any(|g| {
             let g = g as usize;
             g != f && !neighbours.contains(&g) && dist_point_triangle(x, self.mesh.corners(g)) < t
@@ -277,8 +289,12 @@ fn exactly_one_behind(b: &Built, rng: &mut Rand64) -> Counts {
         if loose == 0 || strict > 1 {
             c.violations += 1;
             if std::env::var_os("TC_DEBUG").is_some() && c.violations < 6 {
-                let holders: Vec<(u32, String)> = b.area.cells.iter().filter(|c| c.contains_point(x, 1e-9)).map(|c| (c.triangle, format!("{:?}", c.kind))).collect();
-                eprintln!("violation: face {f} (tri {}) kind {:?} depth {depth:.5} height {height:.5} loose {loose} strict {strict} x {x:?} holders {holders:?}", b.mesh.source_triangle[f], cell.kind);
+                let holders: Vec<(u32, String)> =
+                    b.area.cells.iter().filter(|c| c.contains_point(x, 1e-9)).map(|c| (c.triangle, format!("{:?}", c.kind))).collect();
+                eprintln!(
+                    "violation: face {f} (tri {}) kind {:?} depth {depth:.5} height {height:.5} loose {loose} strict {strict} x {x:?} holders {holders:?}",
+                    b.mesh.source_triangle[f], cell.kind
+                );
             }
         }
     }
@@ -367,7 +383,13 @@ fn check_rule(b: &Built) -> [usize; 4] {
         if near_threshold {
             // Parallel in one computation, converging very far away in the other: both are prisms
             // to within 1e-6 of the face size.
-            assert!(cell.kind == expected || matches!((cell.kind, expected), (CellKind::Prism | CellKind::Ratioed | CellKind::Diverging, CellKind::Prism | CellKind::Ratioed | CellKind::Diverging)));
+            assert!(
+                cell.kind == expected
+                    || matches!(
+                        (cell.kind, expected),
+                        (CellKind::Prism | CellKind::Ratioed | CellKind::Diverging, CellKind::Prism | CellKind::Ratioed | CellKind::Diverging)
+                    )
+            );
         } else {
             assert_eq!(cell.kind, expected, "face {f}: h = {h:?}, t = {t}");
         }
@@ -517,12 +539,23 @@ fn volume_fractions(b: &Built, rng: &mut Rand64, samples: usize, near_vertices: 
         }
     }
     let vn: Vec<Vector> = vn.into_iter().map(|n| n.normalize()).collect();
-    let areas: Vec<Real> = (0..b.mesh.triangles.len()).map(|f| { let [a, bb, c] = b.mesh.corners(f); (bb - a).cross(c - a).length() }).collect();
+    let areas: Vec<Real> = (0..b.mesh.triangles.len())
+        .map(|f| {
+            let [a, bb, c] = b.mesh.corners(f);
+            (bb - a).cross(c - a).length()
+        })
+        .collect();
     let total: Real = areas.iter().sum();
     let (mut tested, mut gap, mut overlap) = (0, 0, 0);
     for _ in 0..samples {
         let mut pick = rng.rand_float() * total;
-        let f = areas.iter().position(|a| { pick -= a; pick <= 0.0 }).unwrap_or(areas.len() - 1);
+        let f = areas
+            .iter()
+            .position(|a| {
+                pick -= a;
+                pick <= 0.0
+            })
+            .unwrap_or(areas.len() - 1);
         let [a, bb, c] = b.mesh.corners(f);
         let (mut u, mut v) = (rng.rand_float(), rng.rand_float());
         if u + v > 1.0 {
@@ -574,7 +607,6 @@ fn gap_and_overlap_near_vertices_are_small_and_measured() {
         assert_eq!((gap2, overlap2), (0, 0), "{name}: gaps or overlaps away from vertices");
     }
 }
-
 
 #[test]
 fn shared_walls_close_the_gaps_and_overlaps_of_naive_prisms_on_v_folds() {

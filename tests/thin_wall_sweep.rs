@@ -32,7 +32,10 @@ fn a_link_behind_the_wall_is_caught_where_coal_misses_it() {
 <joint name="w" type="fixed"><parent link="world"/><child link="wall"/><origin xyz="{WALL_X} 1 0" rpy="1.5707963267948966 0 -1.5707963267948966"/></joint></robot>"#),
     )
     .unwrap();
-    let wall_pose = Pose::from_parts(Vector::new(WALL_X, 1.0, 0.0), Rotation::from_euler(glam::EulerRot::ZYX, -std::f64::consts::FRAC_PI_2, 0.0, std::f64::consts::FRAC_PI_2));
+    let wall_pose = Pose::from_parts(
+        Vector::new(WALL_X, 1.0, 0.0),
+        Rotation::from_euler(glam::EulerRot::ZYX, -std::f64::consts::FRAC_PI_2, 0.0, std::f64::consts::FRAC_PI_2),
+    );
 
     // The hand, tilted, its centre moving along +x through the wall's middle in 5 mm steps.
     let hand = read_mesh(&hand_stl, Vector::ONE).unwrap();
@@ -57,7 +60,11 @@ fn a_link_behind_the_wall_is_caught_where_coal_misses_it() {
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let ours: Vec<bool> = String::from_utf8(out.stdout).unwrap().lines().map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["in_collision"].as_bool().unwrap()).collect();
+    let ours: Vec<bool> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["in_collision"].as_bool().unwrap())
+        .collect();
     assert_eq!(ours.len(), steps.len());
 
     // coal on the plain wall mesh (no thickness), hand mesh against wall mesh.

@@ -196,7 +196,11 @@ impl Checker {
         params.validate()?;
         let resolver = PackageResolver::new(&params.package_map);
         let env_path = environment.map(Path::to_owned).unwrap_or_else(|| {
-            if params.environment_file.is_empty() { bundled_config_dir().join("example_workcell/environment.urdf") } else { PathBuf::from(&params.environment_file) }
+            if params.environment_file.is_empty() {
+                bundled_config_dir().join("example_workcell/environment.urdf")
+            } else {
+                PathBuf::from(&params.environment_file)
+            }
         });
         let use_visual = params.use_visual_when_no_collision;
         let robot = RobotModel::from_str(description, source, Path::new("."), &resolver, use_visual)?;
@@ -239,9 +243,9 @@ impl Checker {
         let mut summary = BuildSummary { robot_source, environment_source, robot_links: robot.links.len(), ..Default::default() };
 
         let mut scene = Scene::new();
-        let env_poses = env.forward_kinematics(&vec![0.0; env.joints.len()], &Isometry3::identity()).map_err(|e| {
-            CheckerError::Model(ModelError::Structure { file: summary.environment_source.clone(), message: e.to_string() })
-        })?;
+        let env_poses = env
+            .forward_kinematics(&vec![0.0; env.joints.len()], &Isometry3::identity())
+            .map_err(|e| CheckerError::Model(ModelError::Structure { file: summary.environment_source.clone(), message: e.to_string() }))?;
         for (li, link) in env.links.iter().enumerate() {
             for g in &link.geometry {
                 let pose = pose_from_isometry(&(env_poses[li] * g.origin));
@@ -259,14 +263,19 @@ impl Checker {
                             let (thickness, side) = params.surface_settings(&link.name);
                             // A closed mesh has an inside: its cells go inward.
                             let side = if closed { Side::Back } else { side };
-                            let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() }).map_err(|e| geo(e.to_string()))?;
+                            let area =
+                                ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() }).map_err(|e| geo(e.to_string()))?;
                             summary.cells += area.cells.len();
                             let _ = scene.add_surface(link.name.clone(), pose, area);
                             summary.thin_surfaces += 1;
                         }
                     }
                     spec => {
-                        let shape = primitive_shape(spec, 0.0).ok_or_else(|| CheckerError::Geometry { link: link.name.clone(), path: PathBuf::new(), message: "degenerate primitive".into() })?;
+                        let shape = primitive_shape(spec, 0.0).ok_or_else(|| CheckerError::Geometry {
+                            link: link.name.clone(),
+                            path: PathBuf::new(),
+                            message: "degenerate primitive".into(),
+                        })?;
                         let _ = scene.add_solid(link.name.clone(), pose, shape);
                         summary.solids += 1;
                     }
@@ -290,16 +299,17 @@ impl Checker {
                         let hull = hull.padded(padding).ok_or_else(|| geo("padding failed"))?;
                         TargetShape::Polytope(Arc::new(hull))
                     }
-                    spec => primitive_shape(spec, padding).ok_or_else(|| CheckerError::Geometry { link: link.name.clone(), path: PathBuf::new(), message: "degenerate primitive".into() })?,
+                    spec => primitive_shape(spec, padding).ok_or_else(|| CheckerError::Geometry {
+                        link: link.name.clone(),
+                        path: PathBuf::new(),
+                        message: "degenerate primitive".into(),
+                    })?,
                 };
                 parts.push((shape, pose_from_isometry(&g.origin)));
             }
             targets.push(LinkTargets { link: li, name: link.name.clone(), parts });
         }
-        let allowed = targets
-            .iter()
-            .map(|t| scene.objects().iter().map(|o| params.is_allowed(&t.name, &o.name)).collect())
-            .collect();
+        let allowed = targets.iter().map(|t| scene.objects().iter().map(|o| params.is_allowed(&t.name, &o.name)).collect()).collect();
         summary.checked_links = targets.len();
         summary.meshes_read = cache.meshes.len();
         summary.build_seconds = started.elapsed().as_secs_f64();

@@ -8,10 +8,7 @@ use thickness_collision::model::mesh_file::read_mesh;
 use thickness_collision::thickness::{Side, ThicknessArea, ThicknessReport, ThicknessSettings};
 
 fn parse_scale(s: &str) -> Result<Vector> {
-    let parts: Vec<f64> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>().with_context(|| format!("--scale: '{p}' is not a number")))
-        .collect::<Result<_>>()?;
+    let parts: Vec<f64> = s.split(',').map(|p| p.trim().parse::<f64>().with_context(|| format!("--scale: '{p}' is not a number"))).collect::<Result<_>>()?;
     let v = match parts[..] {
         [k] => Vector::splat(k),
         [x, y, z] => Vector::new(x, y, z),
@@ -30,8 +27,7 @@ pub fn areas(path: PathBuf, thickness: f64, side: Side, scale: &str, json: Optio
     let scale = parse_scale(scale)?;
     let data = read_mesh(&path, scale)?;
     let started = std::time::Instant::now();
-    let mesh = MeshTopology::build(&data.vertices, &data.triangles, &TopologySettings::default())
-        .with_context(|| format!("mesh file {}", path.display()))?;
+    let mesh = MeshTopology::build(&data.vertices, &data.triangles, &TopologySettings::default()).with_context(|| format!("mesh file {}", path.display()))?;
     let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() })?;
     let elapsed = started.elapsed();
     print_report(&path, &area.report, thickness, side, elapsed);
@@ -46,22 +42,13 @@ fn print_report(path: &std::path::Path, r: &ThicknessReport, t: f64, side: Side,
     let topo = &r.topology;
     println!("{}: {} triangles, {} vertices ({} after welding)", path.display(), topo.input_triangles, topo.input_vertices, topo.vertices);
     println!("  thickness {t} m, side {}, built in {:.3} ms", side.as_str(), elapsed.as_secs_f64() * 1e3);
-    println!(
-        "  cells {}: tetrahedra {}, ratioed {}, prisms {}, diverging {}",
-        r.cells, r.tetrahedra, r.ratioed, r.prisms, r.diverging
-    );
-    println!(
-        "  skipped: degenerate {}, duplicate {}",
-        r.degenerate_skipped, topo.duplicate_triangles
-    );
+    println!("  cells {}: tetrahedra {}, ratioed {}, prisms {}, diverging {}", r.cells, r.tetrahedra, r.ratioed, r.prisms, r.diverging);
+    println!("  skipped: degenerate {}, duplicate {}", r.degenerate_skipped, topo.duplicate_triangles);
     println!(
         "  edges: shared {}, boundary {}, non-manifold {}, inconsistent {}, folded {}",
         topo.shared_edges, r.boundary_edges, r.non_manifold_edges, r.inconsistent_edges, r.folded_edges
     );
-    println!(
-        "  orientation: {} faces flipped; components closed {}, open {}",
-        r.flipped_faces, topo.closed_components, topo.open_components
-    );
+    println!("  orientation: {} faces flipped; components closed {}, open {}", r.flipped_faces, topo.closed_components, topo.open_components);
 }
 
 fn write_cells_json(out: &std::path::Path, area: &ThicknessArea) -> Result<()> {

@@ -63,7 +63,14 @@ pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json
     let s = pipeline.checker().summary();
     eprintln!(
         "loaded {} ({} links, {} checked) and {} ({} thin surfaces, {} cells, {} solids) in {:.1} ms",
-        s.robot_source, s.robot_links, s.checked_links, s.environment_source, s.thin_surfaces, s.cells, s.solids, s.build_seconds * 1e3
+        s.robot_source,
+        s.robot_links,
+        s.checked_links,
+        s.environment_source,
+        s.thin_surfaces,
+        s.cells,
+        s.solids,
+        s.build_seconds * 1e3
     );
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
@@ -88,8 +95,9 @@ pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json
             if line.trim().is_empty() {
                 continue;
             }
-            let state: StateLine = serde_json::from_str(&line)
-                .map_err(|e| anyhow!("{}: line {n}: not a state ({e}); expected {{\"name\": [...], \"position\": [...]}} or {{\"transforms\": [...]}}", path.display()))?;
+            let state: StateLine = serde_json::from_str(&line).map_err(|e| {
+                anyhow!("{}: line {n}: not a state ({e}); expected {{\"name\": [...], \"position\": [...]}} or {{\"transforms\": [...]}}", path.display())
+            })?;
             let checked = check_line(&mut pipeline, state);
             for w in pipeline.take_warnings() {
                 eprintln!("thickness_collision: warning: {w}");
@@ -158,7 +166,11 @@ fn emit(out: &mut impl Write, n: usize, checked: &CheckedState, json: bool) -> R
     for c in &report.contacts {
         let tri = if c.triangle == u32::MAX { "solid".to_string() } else { format!("triangle {}", c.triangle) };
         let point = c.position.map_or("none".into(), |p| format!("[{:.4}, {:.4}, {:.4}]", p[0], p[1], p[2]));
-        writeln!(out, "  {} x {} ({tri}): depth {:.4} m, normal [{:.3}, {:.3}, {:.3}], point {point}", c.link_name, c.object_name, c.depth, c.normal[0], c.normal[1], c.normal[2])?;
+        writeln!(
+            out,
+            "  {} x {} ({tri}): depth {:.4} m, normal [{:.3}, {:.3}, {:.3}], point {point}",
+            c.link_name, c.object_name, c.depth, c.normal[0], c.normal[1], c.normal[2]
+        )?;
     }
     Ok(())
 }

@@ -2,8 +2,8 @@
 
 use crate::ModelArgs;
 use anyhow::{bail, Result};
-use thickness_collision::pipeline::Pipeline;
 use thickness_collision::model::Params;
+use thickness_collision::pipeline::Pipeline;
 
 /// The parameters file (or the defaults) with the command line's overrides applied.
 pub fn params(args: &ModelArgs) -> Result<Params> {

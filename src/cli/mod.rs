@@ -2,7 +2,7 @@
 
 pub mod areas;
 pub mod check;
+mod load;
 pub mod replay;
 #[cfg(feature = "ros")]
 pub mod run;
-mod load;

@@ -1,13 +1,13 @@
 //! One target against one cell: the SAT, then what is reported for a colliding pair.
 
-use super::contact_point::{closest_on_cell, contact_capsule_cell, contact_cylinder_cell, contact_hull_cell};
 use super::cell_tree::{CellSlab, TargetView};
+use super::contact_point::{closest_on_cell, contact_capsule_cell, contact_cylinder_cell, contact_hull_cell};
 use super::polytope::CellPolytope;
 use super::sat::{sat_capsule_cell, sat_hull_cell, sat_sphere_cell, SatOverlap};
 use super::target::{Target, TargetShape};
 use crate::math::{Pose, Real, Rotation, Vector};
-use parry3d_f64::math::Matrix;
 use crate::thickness::{Side, ThicknessCell};
+use parry3d_f64::math::Matrix;
 
 /// What a colliding target/cell pair reports, in the world frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,12 +67,9 @@ impl<'a> LocalPair<'a> {
                 contact_hull_cell(h, &self.cell, push, 1e-12 * scale)
             }
             TargetShape::Sphere { .. } => Some(closest_on_cell(&self.cell, Vector::ZERO)),
-            TargetShape::Capsule { half_height, .. } => Some(contact_capsule_cell(
-                &self.cell,
-                Vector::new(0.0, 0.0, -half_height),
-                Vector::new(0.0, 0.0, *half_height),
-                push,
-            )),
+            TargetShape::Capsule { half_height, .. } => {
+                Some(contact_capsule_cell(&self.cell, Vector::new(0.0, 0.0, -half_height), Vector::new(0.0, 0.0, *half_height), push))
+            }
             TargetShape::Cylinder { half_height, radius } => {
                 // EPA's witness lies on the cylinder but not always in the cell: refine it.
                 let start = cylinder_contact(*half_height, *radius, &self.cell)?.point1;

@@ -320,9 +320,16 @@ impl Builder<'_> {
             return (at, sum);
         }
         // Median split on the longest axis of the cells' centres.
-        let (clo, chi) = self.order[start..end].iter().fold((Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY)), |(lo, hi), (c, _)| (lo.min(*c), hi.max(*c)));
+        let (clo, chi) =
+            self.order[start..end].iter().fold((Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY)), |(lo, hi), (c, _)| (lo.min(*c), hi.max(*c)));
         let ext = chi - clo;
-        let k = if ext.x >= ext.y && ext.x >= ext.z { 0 } else if ext.y >= ext.z { 1 } else { 2 };
+        let k = if ext.x >= ext.y && ext.x >= ext.z {
+            0
+        } else if ext.y >= ext.z {
+            1
+        } else {
+            2
+        };
         let mid = (end - start) / 2;
         let _ = self.order[start..end].select_nth_unstable_by(mid, |a, b| a.0[k].total_cmp(&b.0[k]));
         let (left, sum_l) = self.build(start, start + mid);

@@ -30,4 +30,3 @@ pub use self::cell_tree::CellTree;
 pub use self::report::{CollideSettings, Contact, LeastOverlap, TargetReport};
 pub use self::scene::{ObjectBody, Scene, SceneObject};
 pub use self::target::{ConvexHull, Target, TargetShape};
-

@@ -1,14 +1,14 @@
 //! The environment: objects with their cells in a BVH, and the queries against them.
 
 use super::cell_contact::{normal_axis_deeper, quick_decide, LocalPair, NormalAxis, RecentAxes};
+use super::cell_tree::{transformed_box, CellTree, TargetView};
+use super::gjk::{self, Verdict};
 use super::report::{CollideSettings, Contact, LeastOverlap, TargetReport};
+use super::sat::SatOverlap;
 use super::target::{Target, TargetShape, MANY};
 use crate::math::{Aabb, Pose, Real, Vector};
 use crate::thickness::{ThicknessArea, ThicknessCell};
 use parry3d_f64::bounding_volume::BoundingVolume;
-use super::cell_tree::{transformed_box, CellTree, TargetView};
-use super::gjk::{self, Verdict};
-use super::sat::SatOverlap;
 
 /// What an environment object is made of.
 // A scene holds a handful of objects; boxing the surface would add an indirection to every query.
@@ -174,7 +174,9 @@ impl Scene {
                         if !CellTree::slab_meets_target_box(slab, &view) || recent.separate_box(slab.centre(), slab.half()) {
                             continue;
                         }
-                        let Some((push, depth)) = normal_axis_deeper(target, slab, side, &view.rotation, pos12.translation, Real::NEG_INFINITY) else { continue };
+                        let Some((push, depth)) = normal_axis_deeper(target, slab, side, &view.rotation, pos12.translation, Real::NEG_INFINITY) else {
+                            continue;
+                        };
                         let cell = &area.cells[index as usize];
                         let (hit, sat) = decide(&view, cell, &mut recent, settings.all_contacts || settings.least_overlap);
                         if !hit {
@@ -219,14 +221,21 @@ impl Scene {
 /// A target against a convex solid, with parry's GJK/EPA: the depth is the penetration depth, the
 /// normal the direction that pushes the target out, the point midway between the two witnesses.
 fn collide_solid(target: &Target, object: usize, object_pose: &Pose, shape: &TargetShape) -> Option<Contact> {
-    let c = target.shape.with_parry(|s1, o1| {
-        shape.with_parry(|s2, o2| parry3d_f64::query::contact(&(target.pose * *o1), s1, &(*object_pose * *o2), s2, 0.0).ok().flatten())
-    })?;
+    let c = target
+        .shape
+        .with_parry(|s1, o1| shape.with_parry(|s2, o2| parry3d_f64::query::contact(&(target.pose * *o1), s1, &(*object_pose * *o2), s2, 0.0).ok().flatten()))?;
     if !(c.dist < 0.0) {
         return None;
     }
     let normal = -c.normal1;
-    Some(Contact { object, triangle: u32::MAX, depth: -c.dist, normal, position: Some((c.point1 + c.point2) * 0.5), least: Some(LeastOverlap { overlap: -c.dist, axis: normal }) })
+    Some(Contact {
+        object,
+        triangle: u32::MAX,
+        depth: -c.dist,
+        normal,
+        position: Some((c.point1 + c.point2) * 0.5),
+        least: Some(LeastOverlap { overlap: -c.dist, axis: normal }),
+    })
 }
 
 /// How much deeper than the deepest contact found a subtree's bound must be to be searched: the
@@ -245,7 +254,13 @@ struct Pending(Real, u32);
 /// [`decide`]'s quick tests and GJK where they can; with `least_overlap` the winner's full SAT
 /// gives its least overlap (and, were it to disagree with them, the search is run again with the
 /// SAT alone deciding).
-fn deepest_cell(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candidates: &mut usize, least_overlap: bool) -> Option<(Real, u32, Vector, Option<SatOverlap>)> {
+fn deepest_cell(
+    tree: &CellTree,
+    area: &ThicknessArea,
+    view: &TargetView,
+    candidates: &mut usize,
+    least_overlap: bool,
+) -> Option<(Real, u32, Vector, Option<SatOverlap>)> {
     let (depth, leaf, push, sat) = deepest_search(tree, area, view, candidates, true)?;
     if sat.is_some() || !least_overlap {
         return Some((depth, leaf, push, sat));
@@ -258,7 +273,13 @@ fn deepest_cell(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candid
     deepest_search(tree, area, view, candidates, false)
 }
 
-fn deepest_search(tree: &CellTree, area: &ThicknessArea, view: &TargetView, candidates: &mut usize, quick: bool) -> Option<(Real, u32, Vector, Option<SatOverlap>)> {
+fn deepest_search(
+    tree: &CellTree,
+    area: &ThicknessArea,
+    view: &TargetView,
+    candidates: &mut usize,
+    quick: bool,
+) -> Option<(Real, u32, Vector, Option<SatOverlap>)> {
     let mut best: Option<(Real, u32, Vector, Option<SatOverlap>)> = None;
     let mut best_depth = Real::NEG_INFINITY;
     let mut stack: Vec<Pending> = Vec::with_capacity(64);

@@ -67,7 +67,13 @@ const EXACT: u16 = 1 << 15;
 #[inline]
 fn start_bin(dir: Vector) -> usize {
     let a = dir.abs();
-    let (k, u, v) = if a.x >= a.y && a.x >= a.z { (0, dir.y, dir.z) } else if a.y >= a.z { (1, dir.z, dir.x) } else { (2, dir.x, dir.y) };
+    let (k, u, v) = if a.x >= a.y && a.x >= a.z {
+        (0, dir.y, dir.z)
+    } else if a.y >= a.z {
+        (1, dir.z, dir.x)
+    } else {
+        (2, dir.x, dir.y)
+    };
     let face = 2 * k + (dir[k] < 0.0) as usize;
     let half = 0.5 * START_BINS as Real;
     let scale = half / a[k];
@@ -106,7 +112,8 @@ fn support_cube_map(hull: &ConvexHull) -> Vec<u16> {
     };
     let mut starts = Vec::with_capacity(6 * n * n);
     for face in 0..6 {
-        let corners: Vec<(u16, bool)> = (0..=n).flat_map(|i| (0..=n).map(move |j| (i, j))).map(|(i, j)| extreme(cube_direction(face, grid(i), grid(j)))).collect();
+        let corners: Vec<(u16, bool)> =
+            (0..=n).flat_map(|i| (0..=n).map(move |j| (i, j))).map(|(i, j)| extreme(cube_direction(face, grid(i), grid(j)))).collect();
         for i in 0..n {
             for j in 0..n {
                 let c = [corners[i * (n + 1) + j], corners[i * (n + 1) + j + 1], corners[(i + 1) * (n + 1) + j], corners[(i + 1) * (n + 1) + j + 1]];
@@ -134,8 +141,9 @@ impl ConvexHull {
         if !(h.min_element() > 0.0) {
             return None;
         }
-        let corners: Vec<Vector> =
-            (0..8).map(|i| Vector::new(if i & 1 == 0 { -h.x } else { h.x }, if i & 2 == 0 { -h.y } else { h.y }, if i & 4 == 0 { -h.z } else { h.z })).collect();
+        let corners: Vec<Vector> = (0..8)
+            .map(|i| Vector::new(if i & 1 == 0 { -h.x } else { h.x }, if i & 2 == 0 { -h.y } else { h.y }, if i & 4 == 0 { -h.z } else { h.z }))
+            .collect();
         Self::from_points(&corners)
     }
 
@@ -248,7 +256,6 @@ impl ConvexHull {
 }
 
 impl ConvexHull {
-
     /// `max dir . x`: looked up in the cube map where one vertex is extreme over the whole bin of
     /// `dir` (~80 % of bins on a Panda link hull), else by hill climbing over the vertex graph from
     /// the vertex extreme at the bin's centre, a step or two away (on a convex polytope a vertex
@@ -458,10 +465,9 @@ impl TargetShape {
             TargetShape::Polytope(h) => f(h.as_parry(), &Pose::IDENTITY),
             TargetShape::Sphere { radius } => f(&Ball::new(*radius), &Pose::IDENTITY),
             TargetShape::Capsule { half_height, radius } => f(&Capsule::new_z(*half_height, *radius), &Pose::IDENTITY),
-            TargetShape::Cylinder { half_height, radius } => f(
-                &Cylinder::new(*half_height, *radius),
-                &Pose::from_rotation(crate::math::Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2)),
-            ),
+            TargetShape::Cylinder { half_height, radius } => {
+                f(&Cylinder::new(*half_height, *radius), &Pose::from_rotation(crate::math::Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2)))
+            }
         }
     }
 
@@ -507,4 +513,3 @@ impl Target {
         Aabb::new(lo + pos.translation, hi + pos.translation)
     }
 }
-

@@ -137,11 +137,7 @@ impl MeshTopology {
     /// assert_eq!(mesh.report.boundary_edges, 4);
     /// assert!(mesh.normals.iter().all(|n| n.z > 0.99) || mesh.normals.iter().all(|n| n.z < -0.99));
     /// ```
-    pub fn build(
-        vertices: &[Vector],
-        triangles: &[[u32; 3]],
-        settings: &TopologySettings,
-    ) -> Result<MeshTopology, MeshError> {
+    pub fn build(vertices: &[Vector], triangles: &[[u32; 3]], settings: &TopologySettings) -> Result<MeshTopology, MeshError> {
         let welded = super::weld(vertices, triangles, settings)?;
         Ok(Self::from_welded(welded))
     }
@@ -197,10 +193,7 @@ impl MeshTopology {
         match self.links[f][i] {
             EdgeLink::Shared { face, .. } => {
                 let g = face as usize;
-                let apex = self.triangles[g]
-                    .iter()
-                    .copied()
-                    .find(|v| !self.triangles[f].contains(v))?;
+                let apex = self.triangles[g].iter().copied().find(|v| !self.triangles[f].contains(v))?;
                 let p = self.vertices[apex as usize] - self.vertices[self.triangles[f][i] as usize];
                 Some(p.dot(self.normals[f]) < 0.0)
             }

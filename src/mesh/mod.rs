@@ -13,10 +13,10 @@
 //!    (positive signed volume), an open one keeps the winding of the larger area.
 
 mod adjacency;
+pub mod generate;
 mod mesh_topology;
 mod orient;
 mod weld;
-pub mod generate;
 
 pub use self::mesh_topology::{EdgeLink, MeshError, MeshTopology, TopologyReport, TopologySettings};
 pub use self::weld::{weld, WeldedMesh};

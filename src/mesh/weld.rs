@@ -25,11 +25,7 @@ pub struct WeldedMesh {
 }
 
 /// Welds the vertices of an indexed triangle soup and drops degenerate and duplicate triangles.
-pub fn weld(
-    vertices: &[Vector],
-    triangles: &[[u32; 3]],
-    settings: &TopologySettings,
-) -> Result<WeldedMesh, MeshError> {
+pub fn weld(vertices: &[Vector], triangles: &[[u32; 3]], settings: &TopologySettings) -> Result<WeldedMesh, MeshError> {
     if triangles.is_empty() {
         return Err(MeshError::Empty);
     }
@@ -60,12 +56,7 @@ pub fn weld(
         }
     }
     let min_double_area = 2.0 * settings.degenerate_area * size * size;
-    let mut report = TopologyReport {
-        input_triangles: triangles.len(),
-        input_vertices: vertices.len(),
-        vertices: welded.len(),
-        ..TopologyReport::default()
-    };
+    let mut report = TopologyReport { input_triangles: triangles.len(), input_vertices: vertices.len(), vertices: welded.len(), ..TopologyReport::default() };
     let mut seen: FxHashSet<[u32; 3]> = FxHashSet::default();
     seen.reserve(triangles.len());
     let mut out = Vec::with_capacity(triangles.len());
@@ -73,10 +64,7 @@ pub fn weld(
     for (i, t) in triangles.iter().enumerate() {
         let w = t.map(|v| new_index[remap[v as usize] as usize]);
         let [a, b, c] = w.map(|v| welded[v as usize]);
-        let degenerate = w[0] == w[1]
-            || w[1] == w[2]
-            || w[0] == w[2]
-            || !((b - a).cross(c - a).length() > min_double_area);
+        let degenerate = w[0] == w[1] || w[1] == w[2] || w[0] == w[2] || !((b - a).cross(c - a).length() > min_double_area);
         if degenerate {
             report.degenerate_triangles += 1;
             continue;
@@ -165,14 +153,8 @@ mod tests {
 
     #[test]
     fn degenerate_and_duplicate_triangles_are_counted_and_dropped() {
-        let v = [
-            Vector::new(0.0, 0.0, 0.0),
-            Vector::new(1.0, 0.0, 0.0),
-            Vector::new(0.0, 1.0, 0.0),
-            Vector::new(2.0, 0.0, 0.0),
-        ];
-        let m = weld(&v, &[[0, 1, 2], [0, 0, 1], [0, 1, 3], [2, 0, 1], [0, 2, 1]], &TopologySettings::default())
-            .unwrap();
+        let v = [Vector::new(0.0, 0.0, 0.0), Vector::new(1.0, 0.0, 0.0), Vector::new(0.0, 1.0, 0.0), Vector::new(2.0, 0.0, 0.0)];
+        let m = weld(&v, &[[0, 1, 2], [0, 0, 1], [0, 1, 3], [2, 0, 1], [0, 2, 1]], &TopologySettings::default()).unwrap();
         assert_eq!(m.report.degenerate_triangles, 2); // repeated index, collinear
         assert_eq!(m.report.duplicate_triangles, 2); // same vertex set, either winding
         assert_eq!(m.source_triangle, vec![0]);

@@ -9,7 +9,12 @@ use crate::mesh::generate::{self, Soup};
 /// Name, description and triangles of each example mesh, and whether it is an open (thin) surface.
 pub fn example_meshes() -> Vec<(&'static str, &'static str, Soup, bool)> {
     let mut out: Vec<(&'static str, &'static str, Soup, bool)> = thin_meshes().into_iter().map(|(n, c, s)| (n, c, s, true)).collect();
-    out.push(("gripper.obj", "Gripper body of the example arm: a closed 6 x 10 x 8 cm box (the arm's mesh link).", generate::cuboid(Vector::new(0.03, 0.05, 0.04), 1), false));
+    out.push((
+        "gripper.obj",
+        "Gripper body of the example arm: a closed 6 x 10 x 8 cm box (the arm's mesh link).",
+        generate::cuboid(Vector::new(0.03, 0.05, 0.04), 1),
+        false,
+    ));
     out
 }
 
@@ -45,7 +50,11 @@ fn shelf(w: Real, d: Real, h: Real, n: usize) -> Soup {
     add(generate::flat_grid(n, n, w, d), Pose::IDENTITY, false);
     add(generate::flat_grid(n, n, w, h), Pose::from_parts(Vector::new(0.0, d, 0.0), Rotation::from_rotation_x(q)), false);
     add(generate::flat_grid(n, n, h, d), Pose::from_parts(Vector::ZERO, Rotation::from_rotation_y(-q)), true);
-    add(generate::flat_grid(n, n, h, d), Pose::from_parts(Vector::new(w, d, 0.0), Rotation::from_rotation_z(std::f64::consts::PI) * Rotation::from_rotation_y(-q)), true);
+    add(
+        generate::flat_grid(n, n, h, d),
+        Pose::from_parts(Vector::new(w, d, 0.0), Rotation::from_rotation_z(std::f64::consts::PI) * Rotation::from_rotation_y(-q)),
+        true,
+    );
     (v, t)
 }
 
@@ -61,7 +70,9 @@ pub fn peer_environment(triangles: usize) -> Vec<(String, Soup, Pose)> {
     let n_shelf = ((triangles as f64 / 6.0 / 8.0).sqrt().round() as usize).max(2);
     // Vertical sheets: local x -> world -y (from +0.7), local y -> world z, front (local z) -> world -x.
     let stand = |x: Real, y: Real| Pose::from_parts(Vector::new(x, y, 0.0), Rotation::from_rotation_z(-FRAC_PI_2) * Rotation::from_rotation_x(FRAC_PI_2));
-    let guard = generate::height_field(n_guard, n_guard, 1.4, 1.2, |x, y| 0.012 * (2.0 * std::f64::consts::PI * x / 0.08).sin() + 0.004 * (2.0 * std::f64::consts::PI * y / 0.3).cos());
+    let guard = generate::height_field(n_guard, n_guard, 1.4, 1.2, |x, y| {
+        0.012 * (2.0 * std::f64::consts::PI * x / 0.08).sin() + 0.004 * (2.0 * std::f64::consts::PI * y / 0.3).cos()
+    });
     // A scan: smooth bumps plus deterministic per-vertex noise of +-2 mm.
     let wall = generate::height_field(n_wall, n_wall, 1.6, 1.4, |x, y| {
         let mut k = x.to_bits().wrapping_mul(0x9E3779B97F4A7C15) ^ y.to_bits().rotate_left(29);
@@ -73,7 +84,11 @@ pub fn peer_environment(triangles: usize) -> Vec<(String, Soup, Pose)> {
     vec![
         ("guard_sheet".into(), guard, stand(0.55, 0.7)),
         // Facing +x (towards the robot): rotate the stand pose by pi about z.
-        ("scanned_wall".into(), wall, Pose::from_parts(Vector::new(-0.6, -0.8, 0.0), Rotation::from_rotation_z(FRAC_PI_2) * Rotation::from_rotation_x(FRAC_PI_2))),
+        (
+            "scanned_wall".into(),
+            wall,
+            Pose::from_parts(Vector::new(-0.6, -0.8, 0.0), Rotation::from_rotation_z(FRAC_PI_2) * Rotation::from_rotation_x(FRAC_PI_2)),
+        ),
         ("shelf".into(), shelf(0.6, 0.4, 0.35, n_shelf), Pose::from_parts(Vector::new(0.3, -0.45, 0.25), Rotation::from_rotation_z(std::f64::consts::PI))),
     ]
 }

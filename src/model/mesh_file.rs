@@ -72,9 +72,7 @@ pub fn read_mesh(path: &Path, scale: Vector) -> Result<MeshData, MeshFileError> 
         read_binary_stl(&bytes)
     } else {
         let loader = mesh_loader::Loader::default();
-        let scene = loader
-            .load_from_slice(&bytes, path)
-            .map_err(|e| MeshFileError::Parse { path: path.to_owned(), message: e.to_string() })?;
+        let scene = loader.load_from_slice(&bytes, path).map_err(|e| MeshFileError::Parse { path: path.to_owned(), message: e.to_string() })?;
         let mut data = MeshData::default();
         for mesh in &scene.meshes {
             let base = data.vertices.len() as u32;

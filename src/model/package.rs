@@ -47,11 +47,7 @@ fn split_env(var: &str) -> Vec<PathBuf> {
 impl PackageResolver {
     /// From `package_map` entries (`pkg=/path`) and the environment variables.
     pub fn new(package_map: &[String]) -> PackageResolver {
-        let map = package_map
-            .iter()
-            .filter_map(|e| e.split_once('='))
-            .map(|(k, v)| (k.trim().to_owned(), PathBuf::from(v.trim())))
-            .collect();
+        let map = package_map.iter().filter_map(|e| e.split_once('=')).map(|(k, v)| (k.trim().to_owned(), PathBuf::from(v.trim()))).collect();
         PackageResolver { map, ros_package_path: split_env("ROS_PACKAGE_PATH"), ament_prefix_path: split_env("AMENT_PREFIX_PATH") }
     }
 
@@ -111,9 +107,13 @@ mod tests {
         assert_eq!(r.resolve("package:///my-pkg/a.stl", base).unwrap(), PathBuf::from("/opt/my/a.stl"));
         assert_eq!(r.resolve("meshes/a.stl", base).unwrap(), PathBuf::from("/robots/x/meshes/a.stl"));
         assert_eq!(r.resolve("file:///abs/a.stl", base).unwrap(), PathBuf::from("/abs/a.stl"));
-        let r2 = PackageResolver { ros_package_path: vec!["/nonexistent/ws".into()], ament_prefix_path: vec!["/nonexistent/prefix".into()], ..Default::default() };
+        let r2 =
+            PackageResolver { ros_package_path: vec!["/nonexistent/ws".into()], ament_prefix_path: vec!["/nonexistent/prefix".into()], ..Default::default() };
         let e = r2.resolve("package://nope/a.stl", base).unwrap_err().to_string();
-        assert!(e.contains("package://nope/a.stl") && e.contains("'nope'") && e.contains("/nonexistent/ws/nope") && e.contains("/nonexistent/prefix/share/nope"), "{e}");
+        assert!(
+            e.contains("package://nope/a.stl") && e.contains("'nope'") && e.contains("/nonexistent/ws/nope") && e.contains("/nonexistent/prefix/share/nope"),
+            "{e}"
+        );
         assert!(r.resolve("http://x/a.stl", base).is_err());
     }
 }

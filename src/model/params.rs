@@ -322,10 +322,14 @@ impl Params {
             checked_links: vec![String::new()],
             ..Params::default()
         };
-        sample.flat().into_iter().filter_map(|(n, v)| match v {
-            serde_json::Value::Array(mut a) => a.pop().map(|e| (n, e)),
-            _ => None,
-        }).collect()
+        sample
+            .flat()
+            .into_iter()
+            .filter_map(|(n, v)| match v {
+                serde_json::Value::Array(mut a) => a.pop().map(|e| (n, e)),
+                _ => None,
+            })
+            .collect()
     }
 
     /// These parameters with `name` (dotted, as in [`Params::flat`]) set to `value`, validated.
@@ -423,7 +427,13 @@ mod tests {
     #[test]
     fn overrides_are_typed_and_validated() {
         let p = Params::default();
-        let q = p.with_overrides(&[("default_thickness".into(), "0.05".into()), ("thin_surfaces.patterns".into(), "[a]".into()), ("thin_surfaces.thickness".into(), "[1]".into())]).unwrap();
+        let q = p
+            .with_overrides(&[
+                ("default_thickness".into(), "0.05".into()),
+                ("thin_surfaces.patterns".into(), "[a]".into()),
+                ("thin_surfaces.thickness".into(), "[1]".into()),
+            ])
+            .unwrap();
         assert_eq!(q.default_thickness, 0.05);
         assert_eq!(q.thin_surfaces.thickness, vec![1.0]);
         assert_eq!(q.surface_settings("a"), (1.0, Side::Back));

@@ -251,7 +251,8 @@ impl RobotModel {
                     },
                     urdf_rs::Geometry::Sphere { radius } => GeometrySpec::Sphere(positive("sphere radius", *radius)?),
                     urdf_rs::Geometry::Mesh { filename, scale } => {
-                        let path = resolver.resolve(filename, base_dir).map_err(|source| ModelError::Package { file: file.into(), link: l.name.clone(), source })?;
+                        let path =
+                            resolver.resolve(filename, base_dir).map_err(|source| ModelError::Package { file: file.into(), link: l.name.clone(), source })?;
                         let scale = scale.map_or([1.0; 3], |s| s.0);
                         if let Some(s) = scale.iter().find(|s| !(s.is_finite() && **s != 0.0)) {
                             return Err(bad("mesh scale", *s));
@@ -267,7 +268,9 @@ impl RobotModel {
         let mut joints = Vec::with_capacity(urdf.joints.len());
         let mut parent_of = vec![None; links.len()];
         for (i, j) in urdf.joints.iter().enumerate() {
-            let find = |name: &str, role: &str| link_index.get(name).copied().ok_or_else(|| structure(format!("joint '{}' names {role} link '{name}', which does not exist", j.name)));
+            let find = |name: &str, role: &str| {
+                link_index.get(name).copied().ok_or_else(|| structure(format!("joint '{}' names {role} link '{name}', which does not exist", j.name)))
+            };
             let (parent, child) = (find(&j.parent.link, "parent")?, find(&j.child.link, "child")?);
             if joint_index.insert(j.name.clone(), i).is_some() {
                 return Err(structure(format!("joint '{}' is defined twice", j.name)));

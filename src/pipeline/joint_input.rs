@@ -19,7 +19,14 @@ impl JointInput {
     /// One message: the position of every joint, or why the message gives no state. A bad message
     /// changes nothing (it is not merged). Names that are not joints of `robot` are ignored (other
     /// robots share the topic) and pushed to `unknown`.
-    pub fn ingest(&mut self, robot: &RobotModel, missing: MissingJoint, names: &[String], positions: &[f64], unknown: &mut Vec<String>) -> Result<Vec<f64>, StateError> {
+    pub fn ingest(
+        &mut self,
+        robot: &RobotModel,
+        missing: MissingJoint,
+        names: &[String],
+        positions: &[f64],
+        unknown: &mut Vec<String>,
+    ) -> Result<Vec<f64>, StateError> {
         if names.len() != positions.len() {
             return Err(StateError::Lengths { names: names.len(), positions: positions.len() });
         }

@@ -10,7 +10,12 @@ use nalgebra::Isometry3;
 const ARM: [&str; 7] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
 
 fn js(names: &[&str], positions: &[f64], ns: i64) -> JointState {
-    JointState { header: Header { stamp: Time::from_nanos(ns), frame_id: String::new() }, name: names.iter().map(|s| s.to_string()).collect(), position: positions.to_vec(), ..Default::default() }
+    JointState {
+        header: Header { stamp: Time::from_nanos(ns), frame_id: String::new() },
+        name: names.iter().map(|s| s.to_string()).collect(),
+        position: positions.to_vec(),
+        ..Default::default()
+    }
 }
 
 fn pipeline(params: Params) -> Pipeline {
@@ -142,7 +147,11 @@ fn tf_with_a_prefix_gives_the_joint_state_answer_and_foreign_frames_are_skipped(
     assert_eq!(skip.cause, SkipCause::Unreachable);
     // /tf_static closes the chain; the next /tf is a state.
     let odom = TfMessage {
-        transforms: vec![TransformStamped { header: Header { stamp: Time::default(), frame_id: "world".into() }, child_frame_id: "robot1/odom".into(), transform: Transform::default() }],
+        transforms: vec![TransformStamped {
+            header: Header { stamp: Time::default(), frame_id: "world".into() },
+            child_frame_id: "robot1/odom".into(),
+            transform: Transform::default(),
+        }],
     };
     q.tf_static(&odom).unwrap();
     assert!(q.tf(&tf_message("robot1/", "robot1/odom", &checker, &hit, 10)).is_ok());
@@ -171,7 +180,8 @@ fn world_frame_set_at_run_time_is_used_by_tf_lookups_and_headers() {
 fn a_parameter_rebuild_keeps_a_robot_received_as_description() {
     let urdf = std::fs::read_to_string(crate::model::bundled_config_dir().join("example_workcell/robot.urdf")).unwrap();
     let gripper = crate::model::bundled_config_dir().join("example_workcell/gripper.obj");
-    let urdf = urdf.replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", gripper.display())).replace("name=\"tc_arm\"", "name=\"from_topic\"");
+    let urdf =
+        urdf.replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", gripper.display())).replace("name=\"tc_arm\"", "name=\"from_topic\"");
     let mut p = pipeline(Params::default());
     p.set_robot_description(&urdf, "test").unwrap();
     let thicker = p.params().with_overrides(&[("default_thickness".into(), "0.05".into())]).unwrap();

@@ -152,7 +152,8 @@ impl Pipeline {
         let checker = self.checker.clone();
         let (prefix, world) = (&checker.params().frame_prefix, &checker.params().world_frame);
         let robot = checker.robot();
-        let ours = msg.transforms.iter().any(|t| t.child_frame_id.trim_start_matches('/').strip_prefix(prefix.as_str()).is_some_and(|l| robot.link(l).is_some()));
+        let ours =
+            msg.transforms.iter().any(|t| t.child_frame_id.trim_start_matches('/').strip_prefix(prefix.as_str()).is_some_and(|l| robot.link(l).is_some()));
         if !ours {
             let first = msg.transforms.first().map_or("", |t| t.child_frame_id.as_str());
             return Err(self.skip(SkipCause::NotOurRobot, format!("/tf: frames unknown to the robot (e.g. '{first}', frame_prefix '{prefix}')")));

@@ -42,7 +42,8 @@ impl BagWriter {
     /// Appends one report received at `log_time` (nanoseconds).
     pub fn write(&mut self, report: &CollisionReport, log_time: i64) -> Result<()> {
         let data = encode_cdr_le(report);
-        let header = mcap::records::MessageHeader { channel_id: self.channel, sequence: self.count as u32, log_time: log_time as u64, publish_time: log_time as u64 };
+        let header =
+            mcap::records::MessageHeader { channel_id: self.channel, sequence: self.count as u32, log_time: log_time as u64, publish_time: log_time as u64 };
         self.writer.write_to_known_channel(&header, &data)?;
         self.count += 1;
         let _ = self.first.get_or_insert(log_time);

@@ -3,8 +3,8 @@
 //! rosbag2 bag with the `collisions` topic.
 
 mod bag_reader;
-mod cdr;
 mod bag_writer;
+mod cdr;
 mod replay_run;
 
 pub use self::bag_reader::{open_bag, BagError, BagMessage, BagReader};

@@ -140,7 +140,9 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
     };
     let bar = if opts.progress && std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new_spinner();
-        b.set_style(indicatif::ProgressStyle::with_template("{spinner} {pos} messages {per_sec}").unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()));
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} {pos} messages {per_sec}").unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+        );
         Some(b)
     } else {
         None
@@ -200,7 +202,9 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
                 write_outputs(&mut out, &checked, &pipeline.params().world_frame, m.log_time)?;
             }
             Ok(None) => {}
-            Err(Skip { cause, message }) => warnings.warn(cause.key(), || format!("message at log time {} ns skipped ({}): {message}", m.log_time, cause.key())),
+            Err(Skip { cause, message }) => {
+                warnings.warn(cause.key(), || format!("message at log time {} ns skipped ({}): {message}", m.log_time, cause.key()))
+            }
         }
     }
     if let Some(b) = &bar {
@@ -231,7 +235,8 @@ fn decode<T: serde::de::DeserializeOwned>(pipeline: &mut Pipeline, m: &BagMessag
 
 fn apply_description(pipeline: &mut Pipeline, m: &BagMessage, bag: &Path, summary: &mut ReplaySummary, warnings: &mut FirstWarnings) {
     let source = format!("{DESCRIPTION_TOPIC} in {} at log time {} ns", bag.display(), m.log_time);
-    let result = decode_cdr::<StringMsg>(&m.data).map_err(|e| e.to_string()).and_then(|d| pipeline.set_robot_description(&d.data, &source).map_err(|e| e.to_string()));
+    let result =
+        decode_cdr::<StringMsg>(&m.data).map_err(|e| e.to_string()).and_then(|d| pipeline.set_robot_description(&d.data, &source).map_err(|e| e.to_string()));
     match result {
         Ok(()) => {
             summary.descriptions.0 += 1;

@@ -1,9 +1,9 @@
 //! RViz markers of the cells and the contacts, and the `/diagnostics` status.
 
 use crate::checker::{Checker, StateReport};
+use crate::msgs::{ColorRgba, DiagnosticArray, DiagnosticStatus, DurationMsg, Header, KeyValue, Marker, MarkerArray, Point, Quaternion, Time, Vector3};
 use crate::pipeline::SkipCause;
 use std::collections::BTreeMap;
-use crate::msgs::{ColorRgba, DiagnosticArray, DiagnosticStatus, DurationMsg, Header, KeyValue, Marker, MarkerArray, Point, Quaternion, Time, Vector3};
 
 const TRIANGLE_LIST: i32 = 11;
 const SPHERE_LIST: i32 = 7;

@@ -100,7 +100,6 @@ fn ros_name(name: &str, namespace: &str) -> Result<Name> {
     Name::new(if ns.is_empty() { "/" } else { ns }, base).map_err(|e| anyhow!("invalid ROS name '{full}': {e:?}"))
 }
 
-
 /// The node's topics, publishers, subscriptions and service, made once at start.
 struct Interfaces {
     states: ros2_client::Subscription<JointState>,
@@ -149,8 +148,14 @@ impl Interfaces {
         let topic = |node: &mut Node, name: &str, ns: &str, pkg: &str, ty: &str, qos: &QosProfile| {
             node.create_topic(&ros_name(name, ns)?, MessageTypeName::new(pkg, ty), qos).map_err(|e| anyhow!("topic {name}: {e:?}"))
         };
-        let sub_err = |name: &str| { let name = name.to_owned(); move |e| anyhow!("subscription {name}: {e:?}") };
-        let pub_err = |name: &str| { let name = name.to_owned(); move |e| anyhow!("publisher {name}: {e:?}") };
+        let sub_err = |name: &str| {
+            let name = name.to_owned();
+            move |e| anyhow!("subscription {name}: {e:?}")
+        };
+        let pub_err = |name: &str| {
+            let name = name.to_owned();
+            move |e| anyhow!("publisher {name}: {e:?}")
+        };
 
         let js = topic(node, &names.joint_states, &namespace, "sensor_msgs", "JointState", &best_effort(1))?;
         let states = node.create_subscription::<JointState>(&js, None).map_err(sub_err(&names.joint_states))?;
@@ -285,7 +290,12 @@ impl NodeState {
             match self.pipeline.set_params(params) {
                 Ok(()) => {
                     let s = self.pipeline.checker().summary();
-                    println!("thickness_collision: parameters changed: {} thin surfaces, {} cells rebuilt in {:.1} ms", s.thin_surfaces, s.cells, s.build_seconds * 1e3);
+                    println!(
+                        "thickness_collision: parameters changed: {} thin surfaces, {} cells rebuilt in {:.1} ms",
+                        s.thin_surfaces,
+                        s.cells,
+                        s.build_seconds * 1e3
+                    );
                     self.publish_cells(io);
                 }
                 Err(e) => self.log.warn("params", || format!("parameter change not applied, keeping the current model: {e}")),
@@ -400,7 +410,10 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     let node_name = opts.ros_args.node_name.clone().unwrap_or_else(|| "thickness_collision".into());
     let (changes_tx, changes) = smol::channel::unbounded();
     let mut node = context
-        .new_node(NodeName::new(&namespace, &node_name).map_err(|e| anyhow!("node name {namespace}/{node_name}: {e:?}"))?, parameter_options(pipeline.params(), changes_tx))
+        .new_node(
+            NodeName::new(&namespace, &node_name).map_err(|e| anyhow!("node name {namespace}/{node_name}: {e:?}"))?,
+            parameter_options(pipeline.params(), changes_tx),
+        )
         .map_err(|e| anyhow!("cannot create the node: {e:?}"))?;
     let io = Interfaces::build(&mut node, pipeline.params(), &opts.ros_args)?;
 
@@ -409,7 +422,14 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let p = pipeline.params();
         println!("thickness_collision: node {} on DDS domain {domain}{}", node.fully_qualified_name(), if localhost { " (loopback only)" } else { "" });
         println!("  robot {} ({} links, {} checked)", s.robot_source, s.robot_links, s.checked_links);
-        println!("  environment {} ({} thin surfaces, {} cells, {} solids), built in {:.1} ms", s.environment_source, s.thin_surfaces, s.cells, s.solids, s.build_seconds * 1e3);
+        println!(
+            "  environment {} ({} thin surfaces, {} cells, {} solids), built in {:.1} ms",
+            s.environment_source,
+            s.thin_surfaces,
+            s.cells,
+            s.solids,
+            s.build_seconds * 1e3
+        );
         let input = match p.pose_source {
             PoseSource::Tf => format!("/tf and /tf_static (tf2_msgs/msg/TFMessage, frame prefix '{}')", p.frame_prefix),
             PoseSource::JointStates => format!("{} (sensor_msgs/msg/JointState)", io.names.joint_states),
@@ -424,7 +444,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     }
     let spinner = node.spinner().map_err(|e| anyhow!("spinner: {e:?}"))?;
     let fqn = node.fully_qualified_name();
-    let mut state = NodeState { pipeline, stats: NodeStats::default(), log: RateLimitedLog::default(), sim_time: None, last_markers: None, last_diag: Instant::now(), fqn };
+    let mut state =
+        NodeState { pipeline, stats: NodeStats::default(), log: RateLimitedLog::default(), sim_time: None, last_markers: None, last_diag: Instant::now(), fqn };
 
     smol::block_on(async {
         let spin = smol::spawn(spinner.spin());

@@ -59,7 +59,11 @@ mod tests {
 
     #[test]
     fn remaps_params_and_files() {
-        let v: Vec<String> = ["-r", "__ns:=/robot1", "-r", "__node:=tc", "-r", "joint_states:=/arm/js", "-p", "default_thickness:=0.03", "--params-file", "p.yaml"].iter().map(|s| s.to_string()).collect();
+        let v: Vec<String> =
+            ["-r", "__ns:=/robot1", "-r", "__node:=tc", "-r", "joint_states:=/arm/js", "-p", "default_thickness:=0.03", "--params-file", "p.yaml"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
         let a = parse_ros_args(&v).unwrap();
         assert_eq!(a.namespace.as_deref(), Some("/robot1"));
         assert_eq!(a.node_name.as_deref(), Some("tc"));

@@ -153,14 +153,7 @@ impl ThicknessArea {
                         CellKind::Prism => report.prisms += 1,
                         CellKind::Diverging => report.diverging += 1,
                     }
-                    cells.push(ThicknessCell {
-                        back_cap,
-                        front_cap,
-                        normal: n,
-                        plane_offset: n.dot(p[0]),
-                        triangle: mesh.source_triangle[f],
-                        kind,
-                    });
+                    cells.push(ThicknessCell { back_cap, front_cap, normal: n, plane_offset: n.dot(p[0]), triangle: mesh.source_triangle[f], kind });
                 }
                 None => report.degenerate_skipped += 1,
             }
@@ -241,4 +234,3 @@ fn cap_at(p: [Vector; 3], n: Vector, walls: [Vector; 3], s: Real) -> Option<[Vec
     }
     Some(cap)
 }
-

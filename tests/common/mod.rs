@@ -17,7 +17,8 @@ pub fn python() -> PathBuf {
 /// Runs a peer script from `tests/peers/` with a JSON request on stdin; returns its JSON answer.
 pub fn run_peer(script: &str, request: &serde_json::Value) -> serde_json::Value {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers").join(script);
-    let mut child = Command::new(python()).arg(&path).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("start the Python peer");
+    let mut child =
+        Command::new(python()).arg(&path).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("start the Python peer");
     child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
     let out = child.wait_with_output().unwrap();
     assert!(out.status.success(), "{script} failed: {}", String::from_utf8_lossy(&out.stderr));

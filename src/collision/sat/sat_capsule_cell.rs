@@ -29,10 +29,7 @@ pub(crate) fn sat_capsule_cell(half_height: Real, radius: Real, cell: &CellPolyt
     }
     for e in cell.edges() {
         let (on_seg, on_edge) = closest_segment_segment(p, q, e.a, e.b);
-        if !axis(Vector::Z.cross(e.dir))
-            || !axis(on_edge - on_seg)
-            || !axis(closest_on_segment(p, e.a, e.b) - p)
-            || !axis(closest_on_segment(q, e.a, e.b) - q)
+        if !axis(Vector::Z.cross(e.dir)) || !axis(on_edge - on_seg) || !axis(closest_on_segment(p, e.a, e.b) - p) || !axis(closest_on_segment(q, e.a, e.b) - q)
         {
             return None;
         }
