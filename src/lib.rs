@@ -23,3 +23,8 @@ pub mod replay;
 #[cfg(feature = "ros")]
 pub mod ros;
 pub mod thickness;
+
+// The README's examples are compiled and run by `cargo test`, so they stay true to the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeExamples;
