@@ -11,14 +11,13 @@ mod common;
 
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use thickness_collision::checker::Checker;
 use thickness_collision::math::pose_from_isometry;
 use thickness_collision::model::Params;
 
-const CYCLONE_LOOPBACK: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers><Peer address="127.0.0.1"/></Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>"#;
 const ARM: [&str; 6] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"];
 const FINGER: &str = "finger_left_joint";
 const T0: i64 = 1_700_000_000_000_000_000;
@@ -125,7 +124,7 @@ fn tf_sequence() -> Vec<Value> {
 
 fn cyclone_config(d: &Path) -> PathBuf {
     let f = d.join("cyclone.xml");
-    std::fs::write(&f, CYCLONE_LOOPBACK).unwrap();
+    std::fs::write(&f, common::CYCLONE_LOOPBACK).unwrap();
     f
 }
 
@@ -146,23 +145,7 @@ fn peer(request: &Value, cyclone: Option<&Path>) -> Value {
 /// Runs the node with `args` (loopback only) while the peer sends `messages`; returns the reports
 /// and the node's skip counts by cause from its last `/diagnostics`.
 fn live(messages: &[Value], args: &[&str], domain: u32, d: &Path) -> (Vec<Value>, BTreeMap<String, u64>) {
-    let mut node = bin()
-        .arg("run")
-        .args(args)
-        .env("ROS_DOMAIN_ID", domain.to_string())
-        .env("ROS_LOCALHOST_ONLY", "1")
-        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(node.stdout.take().unwrap());
-    let mut banner = String::new();
-    while !banner.contains("serves") {
-        let mut line = String::new();
-        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
-        banner += &line;
-    }
+    let (mut node, _out, _banner) = common::start_node(args, domain);
     let answer = peer(&json!({"op": "live", "domain": domain, "messages": messages, "timeout": 30}), Some(&cyclone_config(d)));
     let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
     assert!(node.wait().unwrap().success());

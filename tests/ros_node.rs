@@ -11,29 +11,7 @@ use serde_json::{json, Value};
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 
-const CYCLONE_LOOPBACK: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers><Peer address="127.0.0.1"/></Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>"#;
-
-/// Starts the node with loopback-only DDS on `domain` and waits for its banner.
-fn start_node(args: &[&str], domain: u32) -> (std::process::Child, BufReader<std::process::ChildStdout>, String) {
-    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
-        .arg("run")
-        .args(args)
-        .env("ROS_DOMAIN_ID", domain.to_string())
-        .env("ROS_LOCALHOST_ONLY", "1")
-        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(node.stdout.take().unwrap());
-    let mut banner = String::new();
-    while !banner.contains("serves") {
-        let mut line = String::new();
-        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
-        banner += &line;
-    }
-    (node, out, banner)
-}
+use common::{start_node, CYCLONE_LOOPBACK};
 
 /// Runs the Cyclone DDS peer with a loopback-only configuration; returns its JSON answer.
 fn run_dds_peer(cyclone: &std::path::Path, request: &Value) -> Value {

@@ -1,9 +1,36 @@
 //! Shared by the integration tests that talk to the Python peers (coal, yourdfpy, rosbags, ...).
 #![allow(dead_code)]
 
-use std::io::Write;
+use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
+use std::process::{Child, ChildStdout, Command, Stdio};
+
+/// A Cyclone DDS configuration that keeps a peer on loopback: `NetworkInterface 127.0.0.1`, no
+/// multicast, the peer 127.0.0.1 (the network rule in the design notes).
+pub const CYCLONE_LOOPBACK: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers><Peer address="127.0.0.1"/></Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>"#;
+
+/// Starts the node (`run` with `args`) with loopback-only DDS on `domain` and waits for its
+/// banner; returns the process, its standard output after the banner, and the banner.
+pub fn start_node(args: &[&str], domain: u32) -> (Child, BufReader<ChildStdout>, String) {
+    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+        .arg("run")
+        .args(args)
+        .env("ROS_DOMAIN_ID", domain.to_string())
+        .env("ROS_LOCALHOST_ONLY", "1")
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(node.stdout.take().unwrap());
+    let mut banner = String::new();
+    while !banner.contains("serves") {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "the node exited early: {banner}");
+        banner += &line;
+    }
+    (node, out, banner)
+}
 
 /// The peers' interpreter: `$TC_PYTHON`, set by `.ci/run` (`scripts/setup_venv.sh`). A missing
 /// peer is a failure, never a skip.
