@@ -8,7 +8,6 @@
 mod common;
 
 use serde_json::{json, Value};
-use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 
 use common::{start_node, CYCLONE_LOOPBACK};
