@@ -246,14 +246,8 @@ fn tf_with_a_frame_prefix_live_and_replayed_give_the_same_reports_and_skips() {
 
 #[test]
 fn a_robot_description_in_the_bag_applies_from_its_log_time() {
-    use thickness_collision::model::bundled_config_dir;
     let d = dir("desc");
-    // The bundled arm with a fat forearm (radius 0.3 instead of 0.04): it reaches walls it did not.
-    let gripper = bundled_config_dir().join("example_workcell/gripper.obj");
-    let urdf = std::fs::read_to_string(bundled_config_dir().join("example_workcell/robot.urdf"))
-        .unwrap()
-        .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", gripper.display()))
-        .replace("<capsule radius=\"0.04\"", "<capsule radius=\"0.3\"");
+    let urdf = common::fat_arm_urdf();
     let fat = d.join("fat_arm.urdf");
     std::fs::write(&fat, &urdf).unwrap();
     let mut names = ARM.to_vec();

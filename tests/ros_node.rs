@@ -260,18 +260,12 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
 
 #[test]
 fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
-    use thickness_collision::model::bundled_config_dir;
     let dir = std::env::temp_dir().join(format!("tc_ros_node_desc_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let cyclone = dir.join("cyclone.xml");
     std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
     let domain = 200 + std::process::id() % 30;
-    // The bundled arm with a fat forearm (radius 0.3 instead of 0.04): it reaches walls it did not.
-    let gripper = bundled_config_dir().join("example_workcell/gripper.obj");
-    let urdf = std::fs::read_to_string(bundled_config_dir().join("example_workcell/robot.urdf"))
-        .unwrap()
-        .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", gripper.display()))
-        .replace("<capsule radius=\"0.04\"", "<capsule radius=\"0.3\"");
+    let urdf = common::fat_arm_urdf();
     let fat = dir.join("fat_arm.urdf");
     std::fs::write(&fat, &urdf).unwrap();
 

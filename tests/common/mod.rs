@@ -66,3 +66,14 @@ pub fn erd_robot(rel: &str) -> (PathBuf, Vec<String>) {
     let root = example_robot_data();
     (root.join("robots").join(rel), vec![format!("example-robot-data={}", root.display())])
 }
+
+/// The bundled arm with a fat forearm (capsule radius 0.3 instead of 0.04), as URDF text that can
+/// travel as a `robot_description` (its mesh path absolute): it reaches walls the arm does not.
+pub fn fat_arm_urdf() -> String {
+    let config = thickness_collision::model::bundled_config_dir();
+    let gripper = config.join("example_workcell/gripper.obj");
+    std::fs::read_to_string(config.join("example_workcell/robot.urdf"))
+        .unwrap()
+        .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", gripper.display()))
+        .replace("<capsule radius=\"0.04\"", "<capsule radius=\"0.3\"")
+}
