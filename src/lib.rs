@@ -14,6 +14,7 @@
 
 pub mod checker;
 pub mod collision;
+pub mod limits;
 pub mod math;
 pub mod mesh;
 pub mod model;

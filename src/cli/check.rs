@@ -3,41 +3,11 @@
 
 use crate::ModelArgs;
 use anyhow::{anyhow, bail, Context, Result};
-use serde::Deserialize;
 use std::io::{BufRead, Write};
 use std::path::Path;
-use thickness_collision::checker::StateReport;
-use thickness_collision::msgs::{Header, JointState, Quaternion, TfMessage, Time, Transform, TransformStamped, Vector3};
-use thickness_collision::pipeline::{CheckedState, Pipeline};
-
-/// One line of a states file.
-#[derive(Deserialize)]
-#[serde(untagged, deny_unknown_fields)]
-enum StateLine {
-    Joints {
-        name: Vec<String>,
-        position: Vec<f64>,
-        #[serde(default)]
-        stamp: i64,
-    },
-    Transforms {
-        transforms: Vec<LinkTransform>,
-        #[serde(default)]
-        stamp: i64,
-    },
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct LinkTransform {
-    link: String,
-    translation: [f64; 3],
-    rotation: [f64; 4],
-}
-
-/// Longest states-file line read (a state of a few hundred joints is a few kB): a file without
-/// newlines must not be read into memory whole.
-const MAX_LINE: u64 = 1 << 20;
+use thickness_collision::limits::{open_regular, MAX_STATE_LINE_BYTES};
+use thickness_collision::msgs::Time;
+use thickness_collision::pipeline::{parse_state_line, CheckedState};
 
 fn parse_joints(spec: &str) -> Result<(Vec<String>, Vec<f64>)> {
     let mut names = Vec::new();
@@ -79,26 +49,34 @@ pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json
         let report = pipeline.checker().check_joints(&names, &values).context("--joints")?;
         emit(&mut out, 1, &CheckedState { stamp: Time::default(), report }, json)?;
     } else if let Some(path) = states {
-        let file = std::fs::File::open(path).with_context(|| format!("cannot read states file {}", path.display()))?;
-        let mut reader = std::io::BufReader::new(file);
+        // `-` is standard input; anything else must be a regular file (a FIFO or a device would
+        // block or never end).
+        let (source, name): (Box<dyn std::io::Read>, String) = if path == Path::new("-") {
+            (Box::new(std::io::stdin().lock()), "standard input".into())
+        } else {
+            let (file, _) = open_regular(path, "states file", u64::MAX)?;
+            (Box::new(file), path.display().to_string())
+        };
+        let mut reader = std::io::BufReader::new(source);
         let mut first_bad: Option<(usize, String)> = None;
-        let mut line = String::new();
+        let mut line = Vec::new();
         for n in 1.. {
             line.clear();
-            let read = std::io::Read::take(&mut reader, MAX_LINE + 1).read_line(&mut line).with_context(|| format!("{}: line {n}", path.display()))?;
+            let read = std::io::Read::take(&mut reader, MAX_STATE_LINE_BYTES + 1).read_until(b'\n', &mut line).with_context(|| format!("{name}: line {n}"))?;
             if read == 0 {
                 break;
             }
-            if read as u64 > MAX_LINE {
-                bail!("{}: line {n} is longer than {MAX_LINE} bytes", path.display());
+            if read as u64 > MAX_STATE_LINE_BYTES {
+                bail!("{name}: line {n} is longer than {MAX_STATE_LINE_BYTES} bytes, the longest state line read");
             }
-            if line.trim().is_empty() {
+            let Ok(text) = std::str::from_utf8(&line) else {
+                bail!("{name}: line {n}: not UTF-8 text");
+            };
+            if text.trim().is_empty() {
                 continue;
             }
-            let state: StateLine = serde_json::from_str(&line).map_err(|e| {
-                anyhow!("{}: line {n}: not a state ({e}); expected {{\"name\": [...], \"position\": [...]}} or {{\"transforms\": [...]}}", path.display())
-            })?;
-            let checked = check_line(&mut pipeline, state);
+            let state = parse_state_line(text).map_err(|e| anyhow!("{name}: line {n}: {e}"))?;
+            let checked = pipeline.check_line(state);
             for w in pipeline.take_warnings() {
                 eprintln!("thickness_collision: warning: {w}");
             }
@@ -109,42 +87,11 @@ pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json
         }
         out.flush()?;
         if let Some((n, error)) = first_bad {
-            bail!("{}: line {n}: the state cannot be checked: {error} (reported in collision; later lines were checked)", path.display());
+            bail!("{name}: line {n}: the state cannot be checked: {error} (reported in collision; later lines were checked)");
         }
     }
     out.flush()?;
     Ok(())
-}
-
-/// A line through the pipeline; a state it cannot check fails closed in its place.
-fn check_line(pipeline: &mut Pipeline, state: StateLine) -> CheckedState {
-    let (stamp, result) = match state {
-        StateLine::Joints { name, position, stamp } => {
-            let stamp = Time::from_nanos(stamp);
-            let msg = JointState { header: Header { stamp, frame_id: String::new() }, name, position, ..Default::default() };
-            (stamp, pipeline.joint_state(&msg))
-        }
-        StateLine::Transforms { transforms, stamp } => {
-            let stamp = Time::from_nanos(stamp);
-            let (world, prefix) = (pipeline.params().world_frame.clone(), pipeline.params().frame_prefix.clone());
-            let transforms = transforms
-                .into_iter()
-                .map(|t| {
-                    let ([x, y, z], [qx, qy, qz, qw]) = (t.translation, t.rotation);
-                    TransformStamped {
-                        header: Header { stamp, frame_id: world.clone() },
-                        child_frame_id: format!("{prefix}{}", t.link),
-                        transform: Transform { translation: Vector3 { x, y, z }, rotation: Quaternion { x: qx, y: qy, z: qz, w: qw } },
-                    }
-                })
-                .collect();
-            (stamp, pipeline.tf(&TfMessage { transforms }))
-        }
-    };
-    match result {
-        Ok(state) => pipeline.check(&state),
-        Err(skip) => CheckedState { stamp, report: StateReport::failed(skip.message) },
-    }
 }
 
 fn emit(out: &mut impl Write, n: usize, checked: &CheckedState, json: bool) -> Result<()> {

@@ -7,6 +7,7 @@ pub mod mesh_file;
 mod package;
 mod params;
 mod robot;
+pub mod xml_guard;
 
 pub use self::package::{PackageError, PackageResolver};
 pub use self::params::{bundled_config_dir, glob_match, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};

@@ -11,11 +11,13 @@
 mod joint_input;
 mod report_adapter;
 mod skip;
+mod state_line;
 mod state_pipeline;
 mod tf_tree;
 
 pub use self::report_adapter::{report_message, CheckedState};
 pub use self::skip::{Skip, SkipCause};
+pub use self::state_line::{parse_state_line, LinkTransform, StateLine};
 pub use self::state_pipeline::{Pipeline, RobotState};
 
 #[cfg(test)]
