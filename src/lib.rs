@@ -14,6 +14,9 @@
 
 pub mod checker;
 pub mod collision;
+// The fuzz targets' entry points, shared by fuzz/ and tests/fuzz_regressions.rs.
+#[cfg(feature = "testing")]
+pub mod fuzz_entry;
 pub mod limits;
 pub mod math;
 pub mod mesh;

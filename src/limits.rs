@@ -160,6 +160,35 @@ pub fn is_coordinate(v: f64) -> bool {
     v.abs() <= MAX_COORDINATE
 }
 
+thread_local! {
+    static CONTAINING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    static CONTAINED_PANIC: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f`, turning a panic inside it into `Err` with the panic's message and place, printed
+/// nowhere. For code that is not ours and panics on malformed input (mesh-loader); a panic
+/// anywhere else still goes to the hook that was installed before.
+pub fn contain_panic<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if CONTAINING.with(|c| c.get()) {
+                let message = info.payload().downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| info.payload().downcast_ref::<String>().cloned());
+                let place = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+                let text = format!("panicked{place}: {}", message.as_deref().unwrap_or("(no message)"));
+                CONTAINED_PANIC.with(|p| *p.borrow_mut() = Some(text));
+            } else {
+                previous(info);
+            }
+        }));
+    });
+    let outer = CONTAINING.with(|c| c.replace(true));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    CONTAINING.with(|c| c.set(outer));
+    result.map_err(|_| CONTAINED_PANIC.with(|p| p.borrow_mut().take()).unwrap_or_else(|| "panicked".into()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -192,5 +221,15 @@ mod tests {
         let s = name_list(&names);
         assert!(s.len() < 200 && s.ends_with("and 99992 more"), "{s}");
         assert_eq!(name_list(&["a", "b"]), "a, b");
+    }
+
+    #[test]
+    fn contained_panics_become_errors() {
+        assert_eq!(contain_panic(|| 3), Ok(3));
+        let e = contain_panic(|| -> u32 { panic!("index {} out of bounds", 7) }).unwrap_err();
+        assert!(e.contains("index 7 out of bounds") && e.contains("limits.rs"), "{e}");
+        let v: Vec<u8> = Vec::new();
+        let e = contain_panic(|| v[usize::from(v.is_empty())]).unwrap_err();
+        assert!(e.contains("out of bounds"), "{e}");
     }
 }

@@ -5,7 +5,7 @@ use super::state_report::{ReportContact, StateReport};
 use crate::collision::{CollideSettings, ConvexHull, Scene, Target, TargetShape};
 use crate::math::{pose_from_isometry, Pose, Vector};
 use crate::mesh::{MeshTopology, TopologySettings};
-use crate::model::mesh_file::{read_mesh, MeshData, MeshFileError};
+use crate::model::mesh_file::{read_mesh, scale_mesh, MeshData, MeshFileError};
 use crate::model::{bundled_config_dir, GeometrySpec, JointKind, ModelError, PackageResolver, Params, ParamsError, RobotModel};
 use crate::thickness::{Side, ThicknessArea, ThicknessSettings};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
@@ -24,22 +24,26 @@ pub enum CheckerError {
     /// Bad URDF.
     #[error(transparent)]
     Model(#[from] ModelError),
-    /// A mesh file of a link cannot be used.
-    #[error("link '{link}': {source}")]
+    /// A mesh file of a link cannot be used. (The mesh error is part of the message, not a
+    /// `source`: printed as a chain it would repeat itself.)
+    #[error("{file}: link '{link}': {error}")]
     Mesh {
+        /// The URDF (or `robot_description`) naming the mesh.
+        file: String,
         /// Link.
         link: String,
         /// Why.
-        #[source]
-        source: MeshFileError,
+        error: MeshFileError,
     },
-    /// A mesh of a link has no usable geometry.
-    #[error("link '{link}': mesh {path}: {message}")]
+    /// A geometry of a link is not usable.
+    #[error("{file}: link '{link}': {what}: {message}")]
     Geometry {
+        /// The URDF (or `robot_description`).
+        file: String,
         /// Link.
         link: String,
-        /// File.
-        path: PathBuf,
+        /// The geometry: `mesh <file>`, or the primitive with its sizes.
+        what: String,
         /// What is wrong.
         message: String,
     },
@@ -114,14 +118,7 @@ impl MeshCache {
                 d
             }
         };
-        let s = Vector::from_array(scale);
-        let mut out = MeshData { vertices: data.vertices.iter().map(|v| *v * s).collect(), triangles: data.triangles.clone() };
-        if s.x * s.y * s.z < 0.0 {
-            for t in &mut out.triangles {
-                t.swap(1, 2);
-            }
-        }
-        Ok(out)
+        scale_mesh(&data, Vector::from_array(scale), path)
     }
 }
 
@@ -251,8 +248,15 @@ impl Checker {
                 let pose = pose_from_isometry(&(env_poses[li] * g.origin));
                 match &g.spec {
                     GeometrySpec::Mesh { path, scale } => {
-                        let data = cache.get(path, *scale).map_err(|source| CheckerError::Mesh { link: link.name.clone(), source })?;
-                        let geo = |message: String| CheckerError::Geometry { link: link.name.clone(), path: path.clone(), message };
+                        let data = cache
+                            .get(path, *scale)
+                            .map_err(|error| CheckerError::Mesh { file: summary.environment_source.clone(), link: link.name.clone(), error })?;
+                        let geo = |message: String| CheckerError::Geometry {
+                            file: summary.environment_source.clone(),
+                            link: link.name.clone(),
+                            what: format!("mesh {}", path.display()),
+                            message,
+                        };
                         let mesh = MeshTopology::build(&data.vertices, &data.triangles, &TopologySettings::default()).map_err(|e| geo(e.to_string()))?;
                         let closed = mesh.report.boundary_edges == 0 && mesh.report.non_manifold_edges == 0;
                         if closed && params.is_solid_hull(&link.name) {
@@ -272,9 +276,10 @@ impl Checker {
                     }
                     spec => {
                         let shape = primitive_shape(spec, 0.0).ok_or_else(|| CheckerError::Geometry {
+                            file: summary.environment_source.clone(),
                             link: link.name.clone(),
-                            path: PathBuf::new(),
-                            message: "degenerate primitive".into(),
+                            what: format!("{spec:?}"),
+                            message: "not a usable convex shape".into(),
                         })?;
                         let _ = scene.add_solid(link.name.clone(), pose, shape);
                         summary.solids += 1;
@@ -293,16 +298,23 @@ impl Checker {
             for g in &link.geometry {
                 let shape = match &g.spec {
                     GeometrySpec::Mesh { path, scale } => {
-                        let data = cache.get(path, *scale).map_err(|source| CheckerError::Mesh { link: link.name.clone(), source })?;
-                        let geo = |message: &str| CheckerError::Geometry { link: link.name.clone(), path: path.clone(), message: message.into() };
+                        let data =
+                            cache.get(path, *scale).map_err(|error| CheckerError::Mesh { file: summary.robot_source.clone(), link: link.name.clone(), error })?;
+                        let geo = |message: &str| CheckerError::Geometry {
+                            file: summary.robot_source.clone(),
+                            link: link.name.clone(),
+                            what: format!("mesh {}", path.display()),
+                            message: message.into(),
+                        };
                         let hull = ConvexHull::from_points(&data.vertices).ok_or_else(|| geo("its convex hull is flat or empty"))?;
                         let hull = hull.padded(padding).ok_or_else(|| geo("padding failed"))?;
                         TargetShape::Polytope(Arc::new(hull))
                     }
                     spec => primitive_shape(spec, padding).ok_or_else(|| CheckerError::Geometry {
+                        file: summary.robot_source.clone(),
                         link: link.name.clone(),
-                        path: PathBuf::new(),
-                        message: "degenerate primitive".into(),
+                        what: format!("{spec:?}"),
+                        message: "not a usable convex shape".into(),
                     })?,
                 };
                 parts.push((shape, pose_from_isometry(&g.origin)));

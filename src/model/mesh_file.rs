@@ -4,6 +4,8 @@
 //! ASCII); such files are recognised by their size, `84 + 50 n` bytes for `n` triangles, and
 //! parsed here.
 
+use super::xml_guard::check_xml;
+use crate::limits::{contain_panic, is_coordinate, read_regular, InputFileError, LENGTH_RANGE, MAX_COORDINATE, MAX_MESH_BYTES, MAX_MESH_TRIANGLES};
 use crate::math::{Real, Vector};
 use std::path::{Path, PathBuf};
 
@@ -20,15 +22,9 @@ pub struct MeshData {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum MeshFileError {
-    /// The file cannot be read.
-    #[error("cannot read mesh file {path}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        #[source]
-        source: std::io::Error,
-    },
+    /// The file cannot be read (missing, not a regular file, too large).
+    #[error("{0}")]
+    Input(Box<InputFileError>),
     /// The file is not a mesh mesh-loader understands.
     #[error("cannot parse mesh file {path}: {message}")]
     Parse {
@@ -62,24 +58,60 @@ pub enum MeshFileError {
 /// Reads a mesh file and multiplies its coordinates by `scale` (per axis). A scale with an odd
 /// number of negative factors mirrors the mesh; the winding is then reversed to keep the normals
 /// pointing out of the same side.
+///
+/// Only a regular file of at most [`MAX_MESH_BYTES`] is read.
 pub fn read_mesh(path: &Path, scale: Vector) -> Result<MeshData, MeshFileError> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
-    if !matches!(ext.as_str(), "stl" | "obj" | "dae") {
-        return Err(MeshFileError::Format { path: path.to_owned() });
+    let _ = format_of(path)?;
+    let bytes = read_regular(path, "mesh file", MAX_MESH_BYTES).map_err(|e| MeshFileError::Input(Box::new(e)))?;
+    parse_mesh(&bytes, path, scale)
+}
+
+fn format_of(path: &Path) -> Result<&'static str, MeshFileError> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("stl") => Ok("stl"),
+        Some("obj") => Ok("obj"),
+        Some("dae") => Ok("dae"),
+        _ => Err(MeshFileError::Format { path: path.to_owned() }),
     }
-    let bytes = std::fs::read(path).map_err(|source| MeshFileError::Io { path: path.to_owned(), source })?;
-    let mut data = if ext == "stl" && is_binary_stl(&bytes) {
-        read_binary_stl(&bytes)
-    } else {
-        let loader = mesh_loader::Loader::default();
-        let scene = loader.load_from_slice(&bytes, path).map_err(|e| MeshFileError::Parse { path: path.to_owned(), message: e.to_string() })?;
-        let mut data = MeshData::default();
-        for mesh in &scene.meshes {
-            let base = data.vertices.len() as u32;
-            data.vertices.extend(mesh.vertices.iter().map(|v| Vector::new(v[0] as Real, v[1] as Real, v[2] as Real)));
-            data.triangles.extend(mesh.faces.iter().map(|f| f.map(|i| i + base)));
+}
+
+/// [`read_mesh`] on bytes already read; the extension of `path` picks the format and `path`
+/// names the mesh in errors.
+///
+/// mesh-loader panics or aborts on some malformed COLLADA and OBJ; the guards before it refuse
+/// what is known to do that ([`check_xml`], [`check_collada`]), and a panic that still happens is
+/// contained and reported as a parse error, so no mesh can take the process down.
+pub fn parse_mesh(bytes: &[u8], path: &Path, scale: Vector) -> Result<MeshData, MeshFileError> {
+    let parse = |message: String| MeshFileError::Parse { path: path.to_owned(), message };
+    let format = format_of(path)?;
+    let data = match format {
+        "stl" if is_binary_stl(bytes) => read_binary_stl(bytes).map_err(parse)?,
+        _ => {
+            if format == "dae" {
+                check_xml(bytes).map_err(|e| parse(e.to_string()))?;
+                // PENDING(collada_guard): check_collada(bytes).map_err(parse)?;
+            }
+            // Materials do not matter to collision: an OBJ's `mtllib` is never opened (it could
+            // name a FIFO or a device).
+            let no_materials = |_: &Path| -> std::io::Result<Vec<u8>> { Err(std::io::Error::other("material files are not read")) };
+            let loader = mesh_loader::Loader::default();
+            let scene = contain_panic(|| loader.load_from_slice_with_reader(bytes, path, no_materials))
+                .map_err(|panic| parse(format!("the mesh-loader crate failed on this file ({panic})")))?
+                .map_err(|e| parse(one_line(&e.to_string())))?;
+            let mut data = MeshData::default();
+            for mesh in &scene.meshes {
+                let base = data.vertices.len();
+                if let Some(f) = mesh.faces.iter().find(|f| f.iter().any(|&i| i as usize >= mesh.vertices.len())) {
+                    return Err(parse(format!("a face {f:?} indexes past the {} vertices of its mesh", mesh.vertices.len())));
+                }
+                if base + mesh.vertices.len() > u32::MAX as usize || data.triangles.len() + mesh.faces.len() > MAX_MESH_TRIANGLES {
+                    return Err(parse(format!("more than {MAX_MESH_TRIANGLES} triangles")));
+                }
+                data.vertices.extend(mesh.vertices.iter().map(|v| Vector::new(v[0] as Real, v[1] as Real, v[2] as Real)));
+                data.triangles.extend(mesh.faces.iter().map(|f| f.map(|i| i + base as u32)));
+            }
+            data
         }
-        data
     };
     if data.triangles.is_empty() {
         return Err(MeshFileError::Empty { path: path.to_owned() });
@@ -87,31 +119,80 @@ pub fn read_mesh(path: &Path, scale: Vector) -> Result<MeshData, MeshFileError> 
     if let Some(index) = data.vertices.iter().position(|v| !v.is_finite()) {
         return Err(MeshFileError::NonFinite { path: path.to_owned(), index });
     }
-    for v in &mut data.vertices {
-        *v *= scale;
+    if scale == Vector::ONE {
+        return scale_checked(data, path);
     }
+    scale_mesh(&data, scale, path)
+}
+
+/// `data` scaled per axis (the winding reversed for a mirroring scale), with every vertex within
+/// [`MAX_COORDINATE`] and the mesh at least [`LENGTH_RANGE`]`[0]` across.
+pub fn scale_mesh(data: &MeshData, scale: Vector, path: &Path) -> Result<MeshData, MeshFileError> {
+    if let Some(s) = scale.to_array().into_iter().find(|s| !(s.is_finite() && *s != 0.0)) {
+        return Err(MeshFileError::Parse { path: path.to_owned(), message: format!("scale {s} is not a finite, non-zero number") });
+    }
+    let mut out = MeshData { vertices: data.vertices.iter().map(|v| *v * scale).collect(), triangles: data.triangles.clone() };
     if scale.x * scale.y * scale.z < 0.0 {
-        for t in &mut data.triangles {
+        for t in &mut out.triangles {
             t.swap(1, 2);
         }
+    }
+    scale_checked(out, path)
+}
+
+fn scale_checked(data: MeshData, path: &Path) -> Result<MeshData, MeshFileError> {
+    let parse = |message: String| MeshFileError::Parse { path: path.to_owned(), message };
+    if let Some(index) = data.vertices.iter().position(|v| !v.to_array().into_iter().all(is_coordinate)) {
+        let v = data.vertices[index];
+        return Err(parse(format!(
+            "vertex {index} is at [{:e}, {:e}, {:e}] m after scaling; coordinates are allowed up to {MAX_COORDINATE:e} m",
+            v.x, v.y, v.z
+        )));
+    }
+    let (lo, hi) = data.vertices.iter().fold((Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY)), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+    let across = (hi - lo).max_element();
+    if !(across >= LENGTH_RANGE[0]) {
+        return Err(parse(format!("the mesh is {across:e} m across after scaling; the smallest size allowed is {:e} m", LENGTH_RANGE[0])));
     }
     Ok(data)
 }
 
-/// A binary STL: at least the 84-byte header and exactly 50 bytes per declared triangle.
-fn is_binary_stl(bytes: &[u8]) -> bool {
-    if bytes.len() < 84 {
-        return false;
+/// The first line of a parser's message, cut to 300 characters: some parsers print their state.
+fn one_line(message: &str) -> String {
+    let line = message.lines().next().unwrap_or("").trim();
+    match line.char_indices().nth(300) {
+        Some((cut, _)) => format!("{}...", &line[..cut]),
+        None => line.to_owned(),
     }
-    let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
-    bytes.len() == 84 + 50 * n
 }
 
-fn read_binary_stl(bytes: &[u8]) -> MeshData {
-    let n = (bytes.len() - 84) / 50;
+/// A binary STL: at least the 84-byte header, and either a header that does not start with
+/// `solid` or exactly 50 bytes per declared triangle (binary files from some exporters start
+/// with `solid` too).
+fn is_binary_stl(bytes: &[u8]) -> bool {
+    let Some(count) = bytes.get(80..84) else {
+        return false;
+    };
+    let n = u32::from_le_bytes([count[0], count[1], count[2], count[3]]) as u64;
+    !bytes.trim_ascii_start().starts_with(b"solid") || bytes.len() as u64 == 84 + 50 * n
+}
+
+fn read_binary_stl(bytes: &[u8]) -> Result<MeshData, String> {
+    let (header, records) = bytes.split_at(84);
+    let declared = u32::from_le_bytes([header[80], header[81], header[82], header[83]]) as u64;
+    if records.len() as u64 != 50 * declared {
+        return Err(format!(
+            "binary STL declares {declared} triangles ({} bytes) but has {} bytes after its header",
+            50 * declared,
+            records.len()
+        ));
+    }
+    if declared as usize > MAX_MESH_TRIANGLES {
+        return Err(format!("{declared} triangles, more than the {MAX_MESH_TRIANGLES} allowed"));
+    }
+    let n = declared as usize;
     let mut data = MeshData { vertices: Vec::with_capacity(3 * n), triangles: Vec::with_capacity(n) };
-    for k in 0..n {
-        let rec = &bytes[84 + 50 * k..84 + 50 * (k + 1)];
+    for rec in records.chunks_exact(50) {
         let f = |o: usize| f32::from_le_bytes([rec[o], rec[o + 1], rec[o + 2], rec[o + 3]]) as Real;
         let base = data.vertices.len() as u32;
         for c in 0..3 {
@@ -120,7 +201,7 @@ fn read_binary_stl(bytes: &[u8]) -> MeshData {
         }
         data.triangles.push([base, base + 1, base + 2]);
     }
-    data
+    Ok(data)
 }
 
 /// Writes a mesh as Wavefront OBJ (vertices in metres, faces 1-based, counter-clockwise fronts).

@@ -28,6 +28,9 @@ pub enum PackageError {
         /// Every directory tried.
         searched: Vec<PathBuf>,
     },
+    /// A `package://` path that leaves its package (`..`, or an absolute path after the name).
+    #[error("cannot resolve {0}: the path leaves its package (no '..' and no absolute path after package://<name>/)")]
+    Escapes(String),
     /// The URI has a scheme other than `package://` and `file://`.
     #[error("cannot resolve {0}: unsupported URI scheme (expected package://, file:// or a path)")]
     Scheme(String),
@@ -57,6 +60,9 @@ impl PackageResolver {
         if let Some(rest) = uri.strip_prefix("package://") {
             let rest = rest.trim_start_matches('/');
             let (package, rel) = rest.split_once('/').unwrap_or((rest, ""));
+            if Path::new(rel).components().any(|c| !matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir)) {
+                return Err(PackageError::Escapes(uri.to_owned()));
+            }
             return self.package_dir(uri, package).map(|d| d.join(rel));
         }
         if let Some(path) = uri.strip_prefix("file://") {
@@ -115,5 +121,9 @@ mod tests {
             "{e}"
         );
         assert!(r.resolve("http://x/a.stl", base).is_err());
+        for escape in ["package://my-pkg/../../etc/passwd", "package://my-pkg//etc/passwd", "package://my-pkg/meshes/../../x.stl"] {
+            assert_eq!(r.resolve(escape, base), Err(PackageError::Escapes(escape.into())));
+        }
+        assert_eq!(r.resolve("package://my-pkg/./meshes/a.stl", base).unwrap(), PathBuf::from("/opt/my/./meshes/a.stl"));
     }
 }

@@ -2,6 +2,8 @@
 //! collision geometry, joints with limits and mimics, and forward kinematics in `nalgebra` f64.
 
 use super::package::{PackageError, PackageResolver};
+use super::xml_guard::{check_xml, for_each_tag, Tag};
+use crate::limits::{contain_panic, is_coordinate, is_length, name_list, read_regular_text, InputFileError, LENGTH_RANGE, MAX_COORDINATE, MAX_DESCRIPTION_BYTES};
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -136,9 +138,9 @@ pub enum PositionsError {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ModelError {
-    /// The file cannot be read.
-    #[error("cannot read URDF file {0}")]
-    Io(PathBuf, #[source] std::io::Error),
+    /// The file cannot be read (missing, not a regular file, too large).
+    #[error("{0}")]
+    Input(Box<InputFileError>),
     /// urdf-rs rejected the XML.
     #[error("{file}: malformed URDF: {message}")]
     Urdf {
@@ -203,17 +205,101 @@ fn isometry(p: &urdf_rs::Pose) -> Isometry3<f64> {
     Isometry3::from_parts(Translation3::new(p.xyz[0], p.xyz[1], p.xyz[2]), rpy(p.rpy.0))
 }
 
+/// The first line of urdf-rs's message, without the debug dump some of its errors append.
+fn urdf_message(message: &str) -> String {
+    let line = message.lines().next().unwrap_or("").trim();
+    match line.char_indices().nth(300) {
+        Some((cut, _)) => format!("{}...", &line[..cut]),
+        None => line.to_owned(),
+    }
+}
+
+/// Attributes that hold numbers, by element; each whitespace-separated word must parse.
+const NUMERIC_ATTRIBUTES: &[(&str, &[&str])] = &[
+    ("origin", &["xyz", "rpy"]),
+    ("axis", &["xyz"]),
+    ("box", &["size"]),
+    ("cylinder", &["radius", "length"]),
+    ("capsule", &["radius", "length"]),
+    ("sphere", &["radius"]),
+    ("mesh", &["scale"]),
+    ("limit", &["lower", "upper", "effort", "velocity"]),
+    ("mimic", &["multiplier", "offset"]),
+];
+
+const SHAPES: [&str; 5] = ["box", "cylinder", "capsule", "sphere", "mesh"];
+
+/// Checks what urdf-rs would accept silently or report in its own terms: a number that does not
+/// parse (urdf-rs drops the word and counts the rest), and a `<geometry>` without exactly one
+/// shape.
+fn check_urdf_tags(text: &str) -> Result<(), String> {
+    // (line, depth, shapes seen) of the open <geometry>.
+    let mut geometry: Option<(usize, usize, Vec<String>)> = None;
+    let mut depth = 0usize;
+    for_each_tag(text, |t: &Tag| {
+        if t.end {
+            depth = depth.saturating_sub(1);
+        }
+        if let Some((line, d, shapes)) = &geometry {
+            if (t.end || t.empty) && t.name == "geometry" && (t.empty || depth == *d) {
+                let shapes = if t.empty { Vec::new() } else { shapes.clone() };
+                let line = if t.empty { t.line } else { *line };
+                if shapes.len() != 1 {
+                    let found = if shapes.is_empty() { "no shape".to_string() } else { format!("{} shapes ({})", shapes.len(), name_list(&shapes)) };
+                    return Err(format!("line {line}: <geometry> has {found}; expected exactly one of {}", SHAPES.join(", ")));
+                }
+                geometry = None;
+            }
+        } else if t.name == "geometry" && t.empty {
+            return Err(format!("line {}: <geometry> has no shape; expected exactly one of {}", t.line, SHAPES.join(", ")));
+        }
+        if t.end {
+            return Ok(());
+        }
+        if let Some((_, d, shapes)) = &mut geometry {
+            if depth == *d + 1 {
+                shapes.push(t.name.to_owned());
+            }
+        }
+        if let Some((_, names)) = NUMERIC_ATTRIBUTES.iter().find(|(e, _)| *e == t.name) {
+            for (key, value) in &t.attributes {
+                if names.contains(key) {
+                    if let Some(word) = value.split_whitespace().find(|w| w.parse::<f64>().is_err()) {
+                        return Err(format!("line {}: <{} {key}=\"{value}\">: '{word}' is not a number", t.line, t.name));
+                    }
+                }
+            }
+        }
+        if t.name == "geometry" && !t.empty {
+            geometry = Some((t.line, depth, Vec::new()));
+        }
+        if !t.empty {
+            depth += 1;
+        }
+        Ok(())
+    })
+}
+
 impl RobotModel {
     /// Loads a URDF file; relative mesh paths resolve from its folder.
     pub fn from_file(path: &Path, resolver: &PackageResolver, use_visual: bool) -> Result<RobotModel, ModelError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ModelError::Io(path.to_owned(), e))?;
+        let text = read_regular_text(path, "URDF file", MAX_DESCRIPTION_BYTES).map_err(|e| ModelError::Input(Box::new(e)))?;
         let base = path.parent().unwrap_or(Path::new("."));
         Self::from_str(&text, &path.display().to_string(), base, resolver, use_visual)
     }
 
     /// Parses URDF text (`file` names it in errors; relative paths resolve from `base_dir`).
     pub fn from_str(text: &str, file: &str, base_dir: &Path, resolver: &PackageResolver, use_visual: bool) -> Result<RobotModel, ModelError> {
-        let urdf = urdf_rs::read_from_string(text).map_err(|e| ModelError::Urdf { file: file.into(), message: e.to_string() })?;
+        let malformed = |message: String| ModelError::Urdf { file: file.into(), message };
+        if text.len() as u64 > MAX_DESCRIPTION_BYTES {
+            return Err(malformed(format!("{} bytes, more than the {MAX_DESCRIPTION_BYTES} allowed", text.len())));
+        }
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        check_xml(text.as_bytes()).map_err(|e| malformed(e.to_string()))?;
+        check_urdf_tags(text).map_err(malformed)?;
+        let urdf = contain_panic(|| urdf_rs::read_from_string(text))
+            .map_err(|panic| malformed(format!("urdf-rs failed on this text ({panic})")))?
+            .map_err(|e| malformed(urdf_message(&e.to_string())))?;
         let structure = |message: String| ModelError::Structure { file: file.into(), message };
         if urdf.links.is_empty() {
             return Err(structure("the robot has no links".into()));
@@ -232,12 +318,19 @@ impl RobotModel {
             let mut geometry = Vec::new();
             for (origin, g) in elements {
                 let bad = |what: &str, value: f64| ModelError::Value { file: file.into(), what: format!("link '{}' {what}", l.name), value };
-                for v in origin.xyz.0.iter().chain(origin.rpy.0.iter()) {
-                    if !v.is_finite() {
-                        return Err(bad("origin", *v));
-                    }
+                if let Some(v) = origin.xyz.0.iter().find(|v| !is_coordinate(**v)) {
+                    return Err(bad(&format!("origin xyz (allowed: |x| <= {MAX_COORDINATE:e} m)"), *v));
                 }
-                let positive = |what: &str, v: f64| if v > 0.0 && v.is_finite() { Ok(v) } else { Err(bad(what, v)) };
+                if let Some(v) = origin.rpy.0.iter().find(|v| !v.is_finite()) {
+                    return Err(bad("origin rpy", *v));
+                }
+                let positive = |what: &str, v: f64| {
+                    if is_length(v) {
+                        Ok(v)
+                    } else {
+                        Err(bad(&format!("{what} (allowed: {:e} to {:e} m)", LENGTH_RANGE[0], LENGTH_RANGE[1]), v))
+                    }
+                };
                 let spec = match g {
                     urdf_rs::Geometry::Box { size } => {
                         GeometrySpec::Box([positive("box size", size[0])?, positive("box size", size[1])?, positive("box size", size[2])?])
@@ -247,15 +340,15 @@ impl RobotModel {
                     }
                     urdf_rs::Geometry::Capsule { radius, length } => GeometrySpec::Capsule {
                         radius: positive("capsule radius", *radius)?,
-                        length: if *length >= 0.0 && length.is_finite() { *length } else { return Err(bad("capsule length", *length)) },
+                        length: if *length == 0.0 { 0.0 } else { positive("capsule length", *length)? },
                     },
                     urdf_rs::Geometry::Sphere { radius } => GeometrySpec::Sphere(positive("sphere radius", *radius)?),
                     urdf_rs::Geometry::Mesh { filename, scale } => {
                         let path =
                             resolver.resolve(filename, base_dir).map_err(|source| ModelError::Package { file: file.into(), link: l.name.clone(), source })?;
                         let scale = scale.map_or([1.0; 3], |s| s.0);
-                        if let Some(s) = scale.iter().find(|s| !(s.is_finite() && **s != 0.0)) {
-                            return Err(bad("mesh scale", *s));
+                        if let Some(s) = scale.iter().find(|s| !(s.is_finite() && **s != 0.0 && s.abs() <= MAX_COORDINATE)) {
+                            return Err(bad(&format!("mesh scale (allowed: non-zero, |s| <= {MAX_COORDINATE:e})"), *s));
                         }
                         GeometrySpec::Mesh { path, scale }
                     }
@@ -287,21 +380,34 @@ impl RobotModel {
                 urdf_rs::JointType::Planar => JointKind::Planar,
             };
             let a = Vector3::from(j.axis.xyz.0);
-            // Only moving joints need an axis; fixed joints in real URDFs (Talos) carry `0 0 0`.
-            let axis = match Unit::try_new(a, 1e-12) {
-                Some(axis) if a.iter().all(|v| v.is_finite()) => axis,
+            // Scaled by its largest component before normalising: `1e160 0 0` would overflow
+            // the squared norm and give a non-unit rotation.
+            let largest = a.amax();
+            let axis = match Unit::try_new(a / largest, 1e-12) {
+                Some(axis) if largest.is_finite() && largest > 0.0 => axis,
                 _ if matches!(kind, JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic) => {
                     return Err(structure(format!("joint '{}' has a zero or invalid axis {:?}", j.name, j.axis.xyz.0)));
                 }
                 _ => Vector3::z_axis(),
             };
-            for v in j.origin.xyz.0.iter().chain(j.origin.rpy.0.iter()) {
-                if !v.is_finite() {
-                    return Err(ModelError::Value { file: file.into(), what: format!("joint '{}' origin", j.name), value: *v });
-                }
+            let bad = |what: String, value: f64| ModelError::Value { file: file.into(), what: format!("joint '{}' {what}", j.name), value };
+            if let Some(v) = j.origin.xyz.0.iter().find(|v| !is_coordinate(**v)) {
+                return Err(bad(format!("origin xyz (allowed: |x| <= {MAX_COORDINATE:e} m)"), *v));
+            }
+            if let Some(v) = j.origin.rpy.0.iter().find(|v| !v.is_finite()) {
+                return Err(bad("origin rpy".into(), *v));
             }
             let limits = match kind {
-                JointKind::Revolute | JointKind::Prismatic => [j.limit.lower, j.limit.upper],
+                JointKind::Revolute | JointKind::Prismatic => {
+                    let [lower, upper] = [j.limit.lower, j.limit.upper];
+                    if let Some(v) = [lower, upper].into_iter().find(|v| !is_coordinate(*v)) {
+                        return Err(bad(format!("limit (allowed: finite, |x| <= {MAX_COORDINATE:e})"), v));
+                    }
+                    if lower > upper {
+                        return Err(structure(format!("joint '{}' has limit lower {lower} above upper {upper}", j.name)));
+                    }
+                    [lower, upper]
+                }
                 _ => [f64::NEG_INFINITY, f64::INFINITY],
             };
             joints.push(JointModel { name: j.name.clone(), kind, parent, child, origin: isometry(&j.origin), axis, limits, mimic: None });
@@ -309,7 +415,13 @@ impl RobotModel {
         for (i, j) in urdf.joints.iter().enumerate() {
             if let Some(m) = &j.mimic {
                 let target = *joint_index.get(&m.joint).ok_or_else(|| structure(format!("joint '{}' mimics '{}', which does not exist", j.name, m.joint)))?;
-                joints[i].mimic = Some(Mimic { joint: target, multiplier: m.multiplier.unwrap_or(1.0), offset: m.offset.unwrap_or(0.0) });
+                let (multiplier, offset) = (m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0));
+                for (what, v) in [("multiplier", multiplier), ("offset", offset)] {
+                    if !(v.is_finite() && v.abs() <= MAX_COORDINATE) {
+                        return Err(ModelError::Value { file: file.into(), what: format!("joint '{}' mimic {what} (allowed: finite, |x| <= {MAX_COORDINATE:e})", j.name), value: v });
+                    }
+                }
+                joints[i].mimic = Some(Mimic { joint: target, multiplier, offset });
             }
         }
         let roots: Vec<usize> = (0..links.len()).filter(|&l| parent_of[l].is_none()).collect();
@@ -318,7 +430,7 @@ impl RobotModel {
             [] => return Err(structure("the joints form a cycle: no root link".into())),
             _ => {
                 let names: Vec<&str> = roots.iter().map(|&r| links[r].name.as_str()).collect();
-                return Err(structure(format!("more than one root link: {}", names.join(", "))));
+                return Err(structure(format!("{} root links, one allowed (join them with fixed joints): {}", names.len(), name_list(&names))));
             }
         };
         // Breadth-first from the root: parents before children.

@@ -86,6 +86,82 @@ pub fn check_xml(text: &[u8]) -> Result<(), XmlGuardError> {
     Ok(())
 }
 
+/// A start or end tag seen by [`for_each_tag`].
+#[derive(Debug)]
+pub struct Tag<'a> {
+    /// 1-based line of its `<`.
+    pub line: usize,
+    /// Element name.
+    pub name: &'a str,
+    /// Attributes in document order (values not unescaped).
+    pub attributes: Vec<(&'a str, &'a str)>,
+    /// An end tag (`</name>`).
+    pub end: bool,
+    /// A self-closing tag (`<name/>`), which also ends the element.
+    pub empty: bool,
+}
+
+/// Calls `f` for every start and end tag of text [`check_xml`] accepted, in a loop.
+pub fn for_each_tag<'a>(text: &'a str, mut f: impl FnMut(&Tag<'a>) -> Result<(), String>) -> Result<(), String> {
+    let bytes = text.as_bytes();
+    let mut line = 1usize;
+    let mut counted = 0usize;
+    let mut i = 0usize;
+    while let Some(off) = bytes.get(i..).and_then(|t| t.iter().position(|&b| b == b'<')) {
+        let start = i + off;
+        line += bytes[counted..start].iter().filter(|&&b| b == b'\n').count();
+        counted = start;
+        let rest = &text[start..];
+        let skip = |end: &str| rest.find(end).map(|p| start + p + end.len()).unwrap_or(bytes.len());
+        if rest.starts_with("<!--") {
+            i = skip("-->");
+            continue;
+        }
+        if rest.starts_with("<![CDATA[") {
+            i = skip("]]>");
+            continue;
+        }
+        if rest.starts_with("<?") || rest.starts_with("<!") {
+            i = skip(">");
+            continue;
+        }
+        let mut quote = None;
+        let mut close = rest.len();
+        for (k, b) in rest.bytes().enumerate().skip(1) {
+            match (quote, b) {
+                (None, b'"' | b'\'') => quote = Some(b),
+                (Some(q), _) if b == q => quote = None,
+                (None, b'>') => {
+                    close = k;
+                    break;
+                }
+                _ => {}
+            }
+        }
+        let inner = &rest[1..close];
+        i = start + close + 1;
+        let end = inner.starts_with('/');
+        let empty = !end && inner.ends_with('/');
+        let inner = inner.trim_start_matches('/').trim_end_matches('/');
+        let name_len = inner.find(|c: char| c.is_whitespace()).unwrap_or(inner.len());
+        let (name, mut attrs) = inner.split_at(name_len);
+        let mut attributes = Vec::new();
+        while let Some((key, after)) = attrs.split_once('=') {
+            let after = after.trim_start();
+            let Some(q) = after.chars().next().filter(|c| *c == '"' || *c == '\'') else {
+                break;
+            };
+            let Some((value, next)) = after[1..].split_once(q) else {
+                break;
+            };
+            attributes.push((key.trim(), value));
+            attrs = next;
+        }
+        f(&Tag { line, name, attributes, end, empty })?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,5 +184,17 @@ mod tests {
         assert!(matches!(check_xml(b"<robot><!-- open"), Err(XmlGuardError::Unterminated { what: "comment", .. })));
         let urdf = std::fs::read(crate::model::bundled_config_dir().join("example_workcell/robot.urdf")).unwrap();
         assert_eq!(check_xml(&urdf), Ok(()));
+    }
+
+    #[test]
+    fn tags_and_attributes() {
+        let mut seen = Vec::new();
+        let text = "<robot name=\"r\">\n<!-- <x/> -->\n<origin xyz='0 0 1' rpy=\"0 0 0\"/>\n</robot>";
+        for_each_tag(text, |t| {
+            seen.push(format!("{}{}{}@{}{:?}", if t.end { "/" } else { "" }, t.name, if t.empty { "/" } else { "" }, t.line, t.attributes));
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(seen, ["robot@1[(\"name\", \"r\")]", "origin/@3[(\"xyz\", \"0 0 1\"), (\"rpy\", \"0 0 0\")]", "/robot@4[]"]);
     }
 }

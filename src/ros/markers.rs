@@ -91,9 +91,23 @@ impl NodeStats {
     }
 }
 
+/// `DiagnosticStatus` levels.
+const OK: u8 = 0;
+const WARN: u8 = 1;
+const ERROR: u8 = 2;
+
 /// The node's status: input rate, skips by cause and check time over the last `seconds`. Any
-/// skip other than a stale one (a bad or foreign message) raises the level to WARN.
-pub fn diagnostics(node: &str, stats: &mut NodeStats, skipped: &BTreeMap<SkipCause, u64>, seconds: f64, stamp: Time) -> DiagnosticArray {
+/// skip other than a stale one (a bad or foreign message) raises the level to WARN; a refused
+/// `robot_description` (`description_error`, until a good one arrives) to ERROR, with its error
+/// line as the message: the node is checking a robot other than the one described.
+pub fn diagnostics(
+    node: &str,
+    stats: &mut NodeStats,
+    skipped: &BTreeMap<SkipCause, u64>,
+    description_error: Option<&str>,
+    seconds: f64,
+    stamp: Time,
+) -> DiagnosticArray {
     let rate = (stats.received - stats.last_received) as f64 / seconds.max(1e-9);
     let mean = if stats.window_checks > 0 { stats.check_sum / stats.window_checks as f64 } else { 0.0 };
     let total: u64 = skipped.values().sum();
@@ -110,10 +124,16 @@ pub fn diagnostics(node: &str, stats: &mut NodeStats, skipped: &BTreeMap<SkipCau
     for cause in SkipCause::ALL {
         values.push(kv(&format!("skipped_{}", cause.key()), skipped.get(&cause).copied().unwrap_or(0).to_string()));
     }
+    values.push(kv("robot_description_error", description_error.unwrap_or_default().to_owned()));
+    let counts = format!("{rate:.1} states/s, {total} skipped ({bad} bad or foreign)");
+    let (level, message) = match description_error {
+        Some(e) => (ERROR, e.to_owned()),
+        None => (if bad > 0 { WARN } else { OK }, counts),
+    };
     let status = DiagnosticStatus {
-        level: if bad > 0 { 1 } else { 0 },
+        level,
         name: format!("{node}: collision checks"),
-        message: format!("{rate:.1} states/s, {total} skipped ({bad} bad or foreign)"),
+        message,
         hardware_id: String::new(),
         values,
     };

@@ -2,18 +2,21 @@
 //! input to the [`Pipeline`] and publishes what it returns. Nothing here decides an answer.
 
 use super::markers::{cell_markers, contact_markers, diagnostics, NodeStats};
-use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg};
+use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
 use super::param_values::{declarations, to_json, READ_ONLY};
 use super::ros_args::RosArgs;
 use crate::model::{Params, PoseSource, ServiceMapping};
-use crate::msgs::{CollisionReport, DiagnosticArray, JointState, MarkerArray, StringMsg, TfMessage, Time};
+use crate::limits::MAX_DESCRIPTION_BYTES;
+use crate::msgs::{CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
 use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause};
 use anyhow::{anyhow, Context as _, Result};
 use futures::stream::FusedStream;
 use futures::{FutureExt, StreamExt};
 use ros2_client::dds::rustdds::{DomainParticipant, DomainParticipantBuilder};
 use ros2_client::qos::{History, WhenFull};
-use ros2_client::{Context, MessageInfo, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile, ServiceMapping as RosServiceMapping, ServiceTypeName};
+use ros2_client::{
+    Context, MessageInfo, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile, ReadError, ServiceMapping as RosServiceMapping, ServiceTypeName,
+};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::pin::Pin;
@@ -104,7 +107,7 @@ fn ros_name(name: &str, namespace: &str) -> Result<Name> {
 struct Interfaces {
     states: ros2_client::Subscription<JointState>,
     tf: Option<(ros2_client::Subscription<TfMessage>, ros2_client::Subscription<TfMessage>)>,
-    descriptions: ros2_client::Subscription<StringMsg>,
+    descriptions: ros2_client::Subscription<DescriptionMsg>,
     clock: Option<ros2_client::Subscription<ClockMsg>>,
     collisions: ros2_client::Publisher<CollisionReport>,
     cells: ros2_client::Publisher<MarkerArray>,
@@ -161,7 +164,7 @@ impl Interfaces {
         let states = node.create_subscription::<JointState>(&js, None).map_err(sub_err(&names.joint_states))?;
         let desc_qos = latched(QosProfile::subscription_default(), 1);
         let desc = topic(node, &names.description, &namespace, "std_msgs", "String", &desc_qos)?;
-        let descriptions = node.create_subscription::<StringMsg>(&desc, Some(desc_qos.clone())).map_err(sub_err(&names.description))?;
+        let descriptions = node.create_subscription::<DescriptionMsg>(&desc, Some(desc_qos.clone())).map_err(sub_err(&names.description))?;
         let clock = if params.use_sim_time {
             let t = topic(node, "/clock", "/", "rosgraph_msgs", "Clock", &best_effort(1))?;
             Some(node.create_subscription::<ClockMsg>(&t, None).map_err(sub_err("/clock"))?)
@@ -236,12 +239,21 @@ enum Event {
     States(JointState),
     Tf(TfMessage),
     TfStatic(TfMessage),
-    Description(StringMsg),
+    Description(DescriptionMsg),
     Clock(Time),
     Request(ros2_client::service::RmwRequestId, CheckStatesRequest),
-    ReadFailed(&'static str, String),
+    /// A sample that could not be read (on the topic or service named).
+    ReadFailed(&'static str, ReadError),
     Tick,
 }
+
+/// Joint states taken in one turn of the loop at most: the rest wait for the next turn, so a
+/// flood cannot keep the loop from a stop request or the other inputs.
+const MAX_STATES_PER_TURN: usize = 256;
+
+/// How long a stop request waits for the loop (busy building a robot, say) before the process
+/// exits without it: SIGTERM is honoured within 2 s whatever the loop is doing.
+const STOP_GRACE: Duration = Duration::from_millis(1500);
 
 /// The node's state between messages.
 struct NodeState {
@@ -252,6 +264,10 @@ struct NodeState {
     last_markers: Option<Instant>,
     last_diag: Instant,
     fqn: String,
+    /// Why the last `robot_description` was refused; cleared by the next good one.
+    description_error: Option<String>,
+    /// The shutdown line as of the last turn, for a stop that cannot wait for the loop.
+    summary: Arc<Mutex<String>>,
 }
 
 impl NodeState {
@@ -264,6 +280,30 @@ impl NodeState {
 
     fn world(&self) -> String {
         self.pipeline.params().world_frame.clone()
+    }
+
+    /// The line printed at shutdown: messages received, states checked, skips by cause.
+    fn shutdown_line(&self) -> String {
+        let skipped: Vec<String> = self.pipeline.skipped().iter().map(|(c, n)| format!("{n} {}", c.key())).collect();
+        format!(
+            "thickness_collision: shutting down ({} states received, {} checked, skipped: {})",
+            self.stats.received,
+            self.stats.checked,
+            if skipped.is_empty() { "none".to_string() } else { skipped.join(", ") }
+        )
+    }
+
+    /// A sample that could not be read. One that does not decode (a wrong type, a truncated
+    /// sequence, a length past the bytes present, text that is not UTF-8) is counted as
+    /// `undecodable`, like a bag message replay cannot decode, and warned about with the reason.
+    fn on_read_failed(&mut self, what: &'static str, e: &ReadError) {
+        match e {
+            ReadError::Deserialization { .. } | ReadError::Malformed => {
+                self.pipeline.count_skip(SkipCause::Undecodable, 1);
+                self.log.warn(what, || format!("message skipped (undecodable): a {what} sample does not decode: {e}"));
+            }
+            _ => self.log.warn(what, || format!("reading {what} failed: {e}")),
+        }
     }
 
     fn warn_skip(&mut self, skip: &Skip) {
@@ -284,9 +324,15 @@ impl NodeState {
         }
     }
 
-    /// Parameter changes accepted by the service, applied before the next input is handled.
+    /// Parameter changes accepted by the service, applied before the next input is handled. Each
+    /// accepted change carries every parameter, so only the newest is built: a burst of sets costs
+    /// one rebuild.
     fn apply_params(&mut self, io: &Interfaces, changes: &smol::channel::Receiver<Params>) {
+        let mut newest = None;
         while let Ok(params) = changes.try_recv() {
+            newest = Some(params);
+        }
+        if let Some(params) = newest {
             match self.pipeline.set_params(params) {
                 Ok(()) => {
                     let s = self.pipeline.checker().summary();
@@ -321,12 +367,17 @@ impl NodeState {
         }
     }
 
-    /// Joint states: everything already waiting goes through the pipeline in order (merging
-    /// partial states), and the newest good state is checked; older good ones are stale.
+    /// Joint states: everything already waiting (up to [`MAX_STATES_PER_TURN`]) goes through the
+    /// pipeline in order (merging partial states), and the newest good state is checked; older
+    /// good ones are stale. A waiting sample that does not decode is counted and skipped.
     async fn on_joint_states(&mut self, io: &Interfaces, first: JointState) {
         let mut batch = vec![first];
-        while let Ok(Some((m, _))) = io.states.take() {
-            batch.push(m);
+        while batch.len() < MAX_STATES_PER_TURN {
+            match io.states.take() {
+                Ok(Some((m, _))) => batch.push(m),
+                Ok(None) => break,
+                Err(e) => self.on_read_failed("joint_states", &e),
+            }
         }
         self.stats.received += batch.len() as u64;
         let mut newest: Option<RobotState> = None;
@@ -360,15 +411,31 @@ impl NodeState {
         }
     }
 
-    fn on_description(&mut self, io: &Interfaces, msg: StringMsg) {
+    /// A new robot from `robot_description`, built by the pipeline and swapped in whole. A refused
+    /// one leaves the current robot running, is warned about (every one: descriptions are rare)
+    /// and sets `/diagnostics` to ERROR with the reason until a good one arrives.
+    fn on_description(&mut self, io: &Interfaces, msg: DescriptionMsg) {
         let source = format!("{} topic", io.names.description);
-        match self.pipeline.set_robot_description(&msg.data, &source) {
+        let result = match msg {
+            DescriptionMsg::Text(text) => self.pipeline.set_robot_description(&text, &source).map_err(|e| e.to_string()),
+            DescriptionMsg::TooLarge(n) => Err(format!("{source}: {n} bytes of URDF text, more than the {MAX_DESCRIPTION_BYTES} allowed")),
+        };
+        match result {
             Ok(()) => {
                 let s = self.pipeline.checker().summary();
                 println!("thickness_collision: robot from {}: {} links, {} checked", io.names.description, s.robot_links, s.checked_links);
+                self.description_error = None;
                 self.publish_cells(io);
             }
-            Err(e) => self.log.warn("description", || format!("{} rejected, keeping the current robot: {e}", io.names.description)),
+            Err(e) => {
+                // One line whatever the error text holds.
+                let line = format!("{} rejected, keeping the current robot: {}", io.names.description, e.replace('\n', " "));
+                eprintln!("[ERROR] thickness_collision: {line}");
+                if self.log.pending.len() < 64 {
+                    self.log.pending.push(line.clone());
+                }
+                self.description_error = Some(line);
+            }
         }
     }
 
@@ -392,10 +459,14 @@ impl NodeState {
         if elapsed >= Duration::from_secs(1) {
             self.last_diag = Instant::now();
             let now = self.now();
-            let status = diagnostics(&self.fqn, &mut self.stats, self.pipeline.skipped(), elapsed.as_secs_f64(), now);
+            let status = diagnostics(&self.fqn, &mut self.stats, self.pipeline.skipped(), self.description_error.as_deref(), elapsed.as_secs_f64(), now);
             if io.diagnostics.publish(status).is_err() {
                 self.log.warn("diagnostics", || "publishing /diagnostics failed".into());
             }
+        }
+        let line = self.shutdown_line();
+        if let Ok(mut summary) = self.summary.lock() {
+            *summary = line;
         }
     }
 }
@@ -438,14 +509,43 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     }
 
     let stop = Arc::new(AtomicBool::new(false));
+    let (printed, done) = (Arc::new(AtomicBool::new(false)), Arc::new(AtomicBool::new(false)));
+    let summary = Arc::new(Mutex::new(String::new()));
     {
-        let stop = stop.clone();
-        ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst)).context("cannot install the Ctrl-C/SIGTERM handler")?;
+        let (stop, printed, done, summary) = (stop.clone(), printed.clone(), done.clone(), summary.clone());
+        // The loop sees the request at its next turn; if it has not shut down within STOP_GRACE
+        // (a turn building a robot with a huge mesh takes seconds), the process exits from here,
+        // with the counts of the last finished turn.
+        ctrlc::set_handler(move || {
+            stop.store(true, Ordering::SeqCst);
+            let asked = Instant::now();
+            while asked.elapsed() < STOP_GRACE {
+                if done.load(Ordering::SeqCst) {
+                    return;
+                }
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            if printed.compare_exchange(false, true, Ordering::SeqCst, Ordering::SeqCst).is_ok() {
+                let line = summary.lock().map(|s| s.clone()).unwrap_or_default();
+                println!("{line} (forced after {} ms: the loop was busy)", STOP_GRACE.as_millis());
+            }
+            std::process::exit(0);
+        })
+        .context("cannot install the Ctrl-C/SIGTERM handler")?;
     }
     let spinner = node.spinner().map_err(|e| anyhow!("spinner: {e:?}"))?;
     let fqn = node.fully_qualified_name();
-    let mut state =
-        NodeState { pipeline, stats: NodeStats::default(), log: RateLimitedLog::default(), sim_time: None, last_markers: None, last_diag: Instant::now(), fqn };
+    let mut state = NodeState {
+        pipeline,
+        stats: NodeStats::default(),
+        log: RateLimitedLog::default(),
+        sim_time: None,
+        last_markers: None,
+        last_diag: Instant::now(),
+        fqn,
+        description_error: None,
+        summary,
+    };
 
     smol::block_on(async {
         let spin = smol::spawn(spinner.spin());
@@ -461,7 +561,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let mut states: Stream<JointState> = stream_of((!use_tf).then_some(&io.states));
         let mut tfs: Stream<TfMessage> = stream_of(io.tf.as_ref().map(|t| &t.0));
         let mut tf_statics: Stream<TfMessage> = stream_of(io.tf.as_ref().map(|t| &t.1));
-        let mut descriptions: Stream<StringMsg> = stream_of(Some(&io.descriptions));
+        let mut descriptions: Stream<DescriptionMsg> = stream_of(Some(&io.descriptions));
         let mut clocks: Stream<ClockMsg> = stream_of(io.clock.as_ref());
         let mut requests = io.check_states.receive_request_stream();
         while !stop.load(Ordering::SeqCst) {
@@ -469,12 +569,12 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
             let tick = FutureExt::fuse(smol::Timer::after(Duration::from_millis(100)));
             futures::pin_mut!(tick);
             let event = futures::select! {
-                m = states.select_next_some() => m.map_or_else(|e| Event::ReadFailed("joint_states", format!("{e:?}")), |(m, _)| Event::States(m)),
-                m = tfs.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/tf", format!("{e:?}")), |(m, _)| Event::Tf(m)),
-                m = tf_statics.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/tf_static", format!("{e:?}")), |(m, _)| Event::TfStatic(m)),
-                m = descriptions.select_next_some() => m.map_or_else(|e| Event::ReadFailed("robot_description", format!("{e:?}")), |(m, _)| Event::Description(m)),
-                m = clocks.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/clock", format!("{e:?}")), |(m, _)| Event::Clock(m.clock)),
-                r = requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_states", format!("{e:?}")), |(id, req)| Event::Request(id, req)),
+                m = states.select_next_some() => m.map_or_else(|e| Event::ReadFailed("joint_states", e), |(m, _)| Event::States(m)),
+                m = tfs.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/tf", e), |(m, _)| Event::Tf(m)),
+                m = tf_statics.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/tf_static", e), |(m, _)| Event::TfStatic(m)),
+                m = descriptions.select_next_some() => m.map_or_else(|e| Event::ReadFailed("robot_description", e), |(m, _)| Event::Description(m)),
+                m = clocks.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/clock", e), |(m, _)| Event::Clock(m.clock)),
+                r = requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_states", e), |(id, req)| Event::Request(id, req)),
                 _ = tick => Event::Tick,
             };
             // A parameter change accepted before this input arrived applies to it.
@@ -486,22 +586,19 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 Event::Description(m) => state.on_description(&io, m),
                 Event::Clock(t) => state.sim_time = Some(t),
                 Event::Request(id, req) => state.on_request(&io, id, req).await,
-                Event::ReadFailed(what, e) => {
-                    // A sample that does not deserialize: counted like an undecodable bag message.
-                    state.pipeline.count_skip(SkipCause::Undecodable, 1);
-                    state.log.warn(what, || format!("reading {what} failed: {e}"));
-                }
+                Event::ReadFailed(what, e) => state.on_read_failed(what, &e),
                 Event::Tick => {}
             }
         }
-        let skipped: Vec<String> = state.pipeline.skipped().iter().map(|(c, n)| format!("{n} {}", c.key())).collect();
-        println!(
-            "thickness_collision: shutting down ({} states received, {} checked, skipped: {})",
-            state.stats.received,
-            state.stats.checked,
-            if skipped.is_empty() { "none".to_string() } else { skipped.join(", ") }
-        );
+        if printed.compare_exchange(false, true, Ordering::SeqCst, Ordering::SeqCst).is_ok() {
+            println!("{}", state.shutdown_line());
+        }
         drop(spin);
     });
+    // DDS goes down before the stop counts as done (the participant leaves the domain).
+    drop(io);
+    drop(node);
+    drop(context);
+    done.store(true, Ordering::SeqCst);
     Ok(())
 }
