@@ -22,6 +22,9 @@ pub enum StateError {
         /// Its value.
         value: f64,
     },
+    /// A joint named twice in one state.
+    #[error("joint state names joint '{0}' twice")]
+    Duplicate(String),
     /// A joint is missing and `missing_joint` is `reject`.
     #[error("joint state lacks joint '{0}' (missing_joint: reject)")]
     Missing(String),
@@ -60,7 +63,9 @@ pub(crate) fn resolve_positions(model: &RobotModel, names: &[String], positions:
         if !value.is_finite() {
             return Err(StateError::NonFinite { joint: name.clone(), value });
         }
-        q[j] = Some(value);
+        if q[j].replace(value).is_some() {
+            return Err(StateError::Duplicate(name.clone()));
+        }
     }
     model
         .joints

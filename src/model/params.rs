@@ -194,12 +194,21 @@ pub fn bundled_config_dir() -> PathBuf {
 impl Params {
     /// Reads the node's section of a ROS 2 parameters file.
     pub fn from_file(path: &Path) -> Result<Params, ParamsError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ParamsError::Io(path.to_owned(), e))?;
+        let text = crate::limits::read_regular_text(path, "parameters file", crate::limits::MAX_PARAMS_BYTES)
+            .map_err(|e| ParamsError::Io(path.to_owned(), std::io::Error::other(e.to_string())))?;
         Self::from_yaml(&text, path)
     }
 
     /// Parses the node's section of a ROS 2 parameters YAML (`path` names it in errors).
     pub fn from_yaml(text: &str, path: &Path) -> Result<Params, ParamsError> {
+        if text.len() as u64 > crate::limits::MAX_PARAMS_BYTES {
+            return Err(ParamsError::Yaml(path.to_owned(), format!("{} bytes, more than the {} allowed", text.len(), crate::limits::MAX_PARAMS_BYTES)));
+        }
+        // A parameters file has no use for anchors and aliases; refusing them stops an alias
+        // bomb before the parser expands it.
+        if let Some((n, _)) = text.lines().enumerate().find(|(_, l)| has_alias(l)) {
+            return Err(ParamsError::Yaml(path.to_owned(), format!("line {}: YAML anchors and aliases (& and *) are not accepted in a parameters file", n + 1)));
+        }
         let doc: serde_yaml_ng::Value = serde_yaml_ng::from_str(text).map_err(|e| ParamsError::Yaml(path.to_owned(), e.to_string()))?;
         let section = ["thickness_collision", "/thickness_collision", "/**"]
             .iter()
@@ -216,8 +225,12 @@ impl Params {
         if self.robot_base_pose.len() != 6 || self.robot_base_pose.iter().any(|v| !v.is_finite()) {
             return bad("robot_base_pose", format!("needs 6 finite numbers (x y z roll pitch yaw), got {:?}", self.robot_base_pose));
         }
-        if !(self.default_thickness > 0.0 && self.default_thickness.is_finite()) {
-            return bad("default_thickness", format!("must be a positive number of metres, got {:?}", self.default_thickness));
+        let [lo, hi] = crate::limits::LENGTH_RANGE;
+        if !crate::limits::is_length(self.default_thickness) {
+            return bad("default_thickness", format!("must be from {lo:e} to {hi:e} m, got {:?}", self.default_thickness));
+        }
+        if let Some(v) = self.robot_base_pose.iter().take(3).find(|v| !crate::limits::is_coordinate(**v)) {
+            return bad("robot_base_pose", format!("x, y and z must be within {:e} m, got {v:?}", crate::limits::MAX_COORDINATE));
         }
         let ts = &self.thin_surfaces;
         if ts.thickness.len() != ts.patterns.len() {
@@ -226,14 +239,14 @@ impl Params {
         if !ts.side.is_empty() && ts.side.len() != ts.patterns.len() {
             return bad("thin_surfaces.side", format!("has {} values for {} patterns", ts.side.len(), ts.patterns.len()));
         }
-        if let Some(t) = ts.thickness.iter().find(|t| !(**t > 0.0 && t.is_finite())) {
-            return bad("thin_surfaces.thickness", format!("must be positive, got {t:?}"));
+        if let Some(t) = ts.thickness.iter().find(|t| !crate::limits::is_length(**t)) {
+            return bad("thin_surfaces.thickness", format!("must be from {lo:e} to {hi:e} m, got {t:?}"));
         }
         if self.padding.values.len() != self.padding.links.len() {
             return bad("padding.values", format!("has {} values for {} link patterns", self.padding.values.len(), self.padding.links.len()));
         }
-        if let Some(p) = self.padding.values.iter().find(|p| !(**p >= 0.0 && p.is_finite())) {
-            return bad("padding.values", format!("must be >= 0, got {p:?}"));
+        if let Some(p) = self.padding.values.iter().find(|p| !(**p >= 0.0 && **p <= hi)) {
+            return bad("padding.values", format!("must be from 0 to {hi:e} m, got {p:?}"));
         }
         if let Some(p) = self.allowed_collisions.iter().find(|p| p.split(':').count() != 2 || p.split(':').any(str::is_empty)) {
             return bad("allowed_collisions", format!("'{p}' is not of the form robot_link:environment_link"));
@@ -379,6 +392,23 @@ impl Params {
         }
         serde_yaml_ng::to_string(&File { thickness_collision: Section { params: self } }).unwrap_or_default()
     }
+}
+
+/// Whether a YAML line has an anchor (`&name`) or an alias (`*name`) outside quotes and comments.
+fn has_alias(line: &str) -> bool {
+    let mut quote = None;
+    let mut prev = ' ';
+    for c in line.chars() {
+        match (quote, c) {
+            (None, '#') if prev.is_whitespace() => return false,
+            (None, '"' | '\'') => quote = Some(c),
+            (Some(q), _) if c == q => quote = None,
+            (None, '&' | '*') if prev.is_whitespace() || prev == '[' || prev == ',' || prev == ':' => return true,
+            _ => {}
+        }
+        prev = c;
+    }
+    false
 }
 
 /// Glob match with `*` (any run) and `?` (one character).

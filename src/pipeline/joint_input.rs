@@ -34,6 +34,7 @@ impl JointInput {
         for (name, &value) in names.iter().zip(positions) {
             match robot.joint(name) {
                 Some(_) if !value.is_finite() => return Err(StateError::NonFinite { joint: name.clone(), value }),
+                Some(j) if given.iter().any(|(k, _)| *k == j) => return Err(StateError::Duplicate(name.clone())),
                 Some(j) => given.push((j, value)),
                 None => unknown.push(name.clone()),
             }

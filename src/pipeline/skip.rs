@@ -11,6 +11,9 @@ pub enum SkipCause {
     Lengths,
     /// A joint position that is NaN or infinite.
     NonFinite,
+    /// A joint named twice in one state, or a frame given twice in one `/tf` message (which one
+    /// is meant cannot be told).
+    DuplicateName,
     /// An actuated joint never received, under `missing_joint: reject`.
     MissingJoint,
     /// A transform that is not finite or not a rotation, or a new frame past the frame limit.
@@ -25,10 +28,11 @@ pub enum SkipCause {
 
 impl SkipCause {
     /// Every cause, in the order reports list them.
-    pub const ALL: [SkipCause; 8] = [
+    pub const ALL: [SkipCause; 9] = [
         SkipCause::Undecodable,
         SkipCause::Lengths,
         SkipCause::NonFinite,
+        SkipCause::DuplicateName,
         SkipCause::MissingJoint,
         SkipCause::BadTransform,
         SkipCause::NotOurRobot,
@@ -42,6 +46,7 @@ impl SkipCause {
             SkipCause::Undecodable => "undecodable",
             SkipCause::Lengths => "lengths",
             SkipCause::NonFinite => "non_finite",
+            SkipCause::DuplicateName => "duplicate_name",
             SkipCause::MissingJoint => "missing_joint",
             SkipCause::BadTransform => "bad_transform",
             SkipCause::NotOurRobot => "not_our_robot",

@@ -124,6 +124,7 @@ impl Pipeline {
                 let cause = match e {
                     StateError::Lengths { .. } => SkipCause::Lengths,
                     StateError::NonFinite { .. } => SkipCause::NonFinite,
+                    StateError::Duplicate(_) => SkipCause::DuplicateName,
                     _ => SkipCause::MissingJoint,
                 };
                 Err(self.skip(cause, e.to_string()))
@@ -140,6 +141,7 @@ impl Pipeline {
         let message = match r {
             TfRejection::NotRigid(f) => format!("{topic}: the transform of frame '{f}' is not a finite rigid transform"),
             TfRejection::TooManyFrames(f) => format!("{topic}: new frame '{f}' would pass {} frames", TfTree::MAX_FRAMES),
+            TfRejection::Duplicate(f) => return self.skip(SkipCause::DuplicateName, format!("{topic}: frame '{f}' is given twice in one message")),
         };
         self.skip(SkipCause::BadTransform, message)
     }

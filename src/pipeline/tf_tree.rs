@@ -17,6 +17,8 @@ pub(crate) enum TfRejection {
     NotRigid(String),
     /// This new frame would pass [`TfTree::MAX_FRAMES`].
     TooManyFrames(String),
+    /// This child frame is given twice in one message.
+    Duplicate(String),
 }
 
 impl TfTree {
@@ -29,14 +31,18 @@ impl TfTree {
     pub fn update(&mut self, msg: &TfMessage) -> Result<(), TfRejection> {
         let mut parsed = Vec::with_capacity(msg.transforms.len());
         let mut new_frames = 0;
+        let mut seen = rustc_hash::FxHashSet::default();
         for t in &msg.transforms {
             let (tr, q) = (t.transform.translation, t.transform.rotation);
             let rot = Rotation::from_xyzw(q.x, q.y, q.z, q.w);
             let v = Vector::new(tr.x, tr.y, tr.z);
-            if !v.is_finite() || !rot.is_finite() || (rot.length() - 1.0).abs() > 1e-6 {
+            if !v.to_array().into_iter().all(crate::limits::is_coordinate) || !rot.is_finite() || (rot.length() - 1.0).abs() > 1e-6 {
                 return Err(TfRejection::NotRigid(t.child_frame_id.clone()));
             }
             let child = strip(&t.child_frame_id);
+            if !seen.insert(child) {
+                return Err(TfRejection::Duplicate(t.child_frame_id.clone()));
+            }
             if !self.edges.contains_key(child) {
                 new_frames += 1;
                 if self.edges.len() + new_frames > Self::MAX_FRAMES {
