@@ -56,8 +56,8 @@ pub struct BagMessage {
 #[non_exhaustive]
 pub enum BagError {
     /// The file cannot be read.
-    #[error("cannot read bag {0}")]
-    Io(PathBuf, #[source] std::io::Error),
+    #[error("cannot read bag {0}: {1}")]
+    Io(PathBuf, std::io::Error),
     /// Not a directory with metadata.yaml, an .mcap or a .db3 file.
     #[error("{0}: unknown storage format (expected a rosbag2 directory with metadata.yaml, an .mcap file or a .db3 file)")]
     UnknownFormat(PathBuf),
@@ -190,13 +190,26 @@ impl std::iter::FusedIterator for BagReader {}
 pub fn open_bag(path: &Path) -> Result<BagReader, BagError> {
     let (storage, files) = if path.is_dir() {
         let meta_path = path.join("metadata.yaml");
-        let text = std::fs::read_to_string(&meta_path).map_err(|_| BagError::UnknownFormat(path.to_owned()))?;
+        if !meta_path.exists() {
+            return Err(BagError::UnknownFormat(path.to_owned()));
+        }
+        let text = crate::limits::read_regular_text(&meta_path, "bag metadata", crate::limits::MAX_DESCRIPTION_BYTES)
+            .map_err(|e| BagError::Metadata(path.to_owned(), e.to_string()))?;
         let meta: serde_yaml_ng::Value = serde_yaml_ng::from_str(&text).map_err(|e| BagError::Metadata(path.to_owned(), e.to_string()))?;
         let info = &meta["rosbag2_bagfile_information"];
         let files: Vec<PathBuf> =
             info["relative_file_paths"].as_sequence().map(|s| s.iter().filter_map(|f| f.as_str()).map(|f| path.join(f)).collect()).unwrap_or_default();
         if files.is_empty() {
             return Err(BagError::Metadata(path.to_owned(), "relative_file_paths is empty or missing".into()));
+        }
+        for (i, f) in files.iter().enumerate() {
+            let rel = f.strip_prefix(path).unwrap_or(f);
+            if rel.components().any(|c| !matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir)) {
+                return Err(BagError::Metadata(path.to_owned(), format!("relative_file_paths: '{}' leaves the bag directory", rel.display())));
+            }
+            if files[..i].contains(f) {
+                return Err(BagError::Metadata(path.to_owned(), format!("relative_file_paths lists '{}' twice", rel.display())));
+            }
         }
         let storage = match info["storage_identifier"].as_str().unwrap_or("") {
             "mcap" => Storage::Mcap,
@@ -378,17 +391,25 @@ impl Declared {
     }
 }
 
+/// A bag file opened only when it is a regular file (a FIFO would block, a device never end).
+fn open_bag_file(path: &Path) -> Result<File, BagError> {
+    crate::limits::open_regular(path, "bag file", u64::MAX).map(|(f, _)| f).map_err(|e| match e {
+        crate::limits::InputFileError::Io { source, .. } => BagError::Io(path.to_owned(), source),
+        other => BagError::Io(path.to_owned(), std::io::Error::other(other.to_string())),
+    })
+}
+
 /// The topics of an MCAP file, and the fault that cut the scan short when there was no summary.
 fn mcap_topics(path: &Path) -> Result<(Topics, Option<BagError>), BagError> {
     let io = |e| BagError::Io(path.to_owned(), e);
-    let file = File::open(path).map_err(io)?;
+    let file = open_bag_file(path)?;
     let size = file.metadata().map_err(io)?.len();
     if let Some(topics) = summary_topics(file, size) {
         return Ok((topics, None));
     }
     // No usable summary: one pass over the channel records (data bytes are skipped, but chunks
     // have to be decompressed to find the records in them).
-    let mut pump = Pump::new(File::open(path).map_err(io)?, LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES));
+    let mut pump = Pump::new(open_bag_file(path)?, LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES));
     let mut declared = Declared::default();
     let (mut records, mut messages) = (0usize, 0usize);
     let scan = pump.next_record(|opcode, body| {
@@ -454,7 +475,7 @@ struct McapStream {
 
 impl McapStream {
     fn open(path: &Path) -> Result<Self, BagError> {
-        let file = File::open(path).map_err(|e| BagError::Io(path.to_owned(), e))?;
+        let file = open_bag_file(path)?;
         let options = LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES).with_validate_chunk_crcs(true);
         Ok(McapStream { path: path.to_owned(), pump: Pump::new(file, options), channels: ChannelAccumulator::default(), past_data_end: false, read: 0 })
     }

@@ -101,6 +101,7 @@ impl FirstWarnings {
 /// Where the checked states go.
 struct Outputs {
     jsonl: Option<std::io::BufWriter<std::fs::File>>,
+    jsonl_path: Option<PathBuf>,
     bag: Option<BagWriter>,
 }
 
@@ -115,6 +116,16 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
         params.frame_prefix = p.clone();
     }
     let pose_source = params.pose_source;
+    for (flag, v) in [("--start", opts.start), ("--end", opts.end)] {
+        if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+            bail!("{flag} {v}: must be a finite number of seconds >= 0 after the bag's first message");
+        }
+    }
+    if let (Some(a), Some(b)) = (opts.start, opts.end) {
+        if a > b {
+            bail!("--start {a} is after --end {b}: no message could be replayed");
+        }
+    }
     let bag = open_bag(&opts.bag)?;
     let topic = opts.topic.clone().unwrap_or_else(|| match pose_source {
         PoseSource::JointStates => "/joint_states".into(),
@@ -122,7 +133,14 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
     });
     if !bag.topics().iter().any(|(t, _)| *t == topic) {
         let have: Vec<&str> = bag.topics().iter().map(|(t, _)| t.as_str()).collect();
-        bail!("topic {topic} is not in bag {} (it has: {})", opts.bag.display(), have.join(", "));
+        bail!("topic {topic} is not in bag {} (it has: {})", opts.bag.display(), crate::limits::name_list(&have));
+    }
+    let expected = match pose_source {
+        PoseSource::JointStates => "sensor_msgs/msg/JointState",
+        PoseSource::Tf => "tf2_msgs/msg/TFMessage",
+    };
+    if let Some((_, ty)) = bag.topics().iter().find(|(t, ty)| *t == topic && !ty.is_empty() && ty != expected) {
+        bail!("topic {topic} in bag {} has type {ty}; pose_source {} reads {expected}", opts.bag.display(), if pose_source == PoseSource::Tf { "tf" } else { "joint_states" });
     }
     // Both doors start with the robot the parameters name; a description in the bag replaces it
     // at its log time, as it would replace it in the running node.
@@ -133,6 +151,7 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
             Some(p) => Some(std::io::BufWriter::new(std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?)),
             None => None,
         },
+        jsonl_path: opts.jsonl.clone(),
         bag: match &opts.out_dir {
             Some(d) => Some(BagWriter::create(d, "/collisions")?),
             None => None,
@@ -210,8 +229,8 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    if let Some(mut w) = out.jsonl {
-        w.flush()?;
+    if let (Some(mut w), Some(path)) = (out.jsonl, &opts.jsonl) {
+        w.flush().with_context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(b) = out.bag {
         let _ = b.finish()?;
@@ -263,9 +282,8 @@ fn record(summary: &mut ReplaySummary, checked: &CheckedState) {
 }
 
 fn write_outputs(out: &mut Outputs, checked: &CheckedState, frame: &str, log_time: i64) -> Result<()> {
-    if let Some(w) = out.jsonl.as_mut() {
-        w.write_all(checked.json().as_bytes())?;
-        w.write_all(b"\n")?;
+    if let (Some(w), Some(path)) = (out.jsonl.as_mut(), &out.jsonl_path) {
+        w.write_all(checked.json().as_bytes()).and_then(|()| w.write_all(b"\n")).with_context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(b) = out.bag.as_mut() {
         b.write(&checked.message(frame), log_time)?;
