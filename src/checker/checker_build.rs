@@ -35,6 +35,10 @@ pub enum CheckerError {
         /// Why.
         error: MeshFileError,
     },
+    /// Building panicked (a defect, in this crate or a dependency): contained, so the robot in
+    /// use stays.
+    #[error("building the checker failed: {0}")]
+    Panicked(String),
     /// A geometry of a link is not usable.
     #[error("{file}: link '{link}': {what}: {message}")]
     Geometry {

@@ -14,15 +14,16 @@ fn parse_scale(s: &str) -> Result<Vector> {
         [x, y, z] => Vector::new(x, y, z),
         _ => bail!("--scale takes one factor or three (sx,sy,sz), got '{s}'"),
     };
-    if !v.is_finite() || v.x * v.y * v.z == 0.0 {
+    if !v.is_finite() || v.to_array().contains(&0.0) {
         bail!("--scale must be finite and non-zero, got '{s}'");
     }
     Ok(v)
 }
 
 pub fn areas(path: PathBuf, thickness: f64, side: Side, scale: &str, json: Option<PathBuf>) -> Result<()> {
-    if !(thickness > 0.0 && thickness.is_finite()) {
-        bail!("--thickness must be a positive number of metres, got {thickness}");
+    if !thickness_collision::limits::is_length(thickness) {
+        let [lo, hi] = thickness_collision::limits::LENGTH_RANGE;
+        bail!("--thickness {thickness}: must be from {lo:e} to {hi:e} m");
     }
     let scale = parse_scale(scale)?;
     let data = read_mesh(&path, scale)?;

@@ -12,8 +12,9 @@ pub fn params(args: &ModelArgs) -> Result<Params> {
         None => Params::default(),
     };
     if let Some(t) = args.thickness {
-        if !(t > 0.0 && t.is_finite()) {
-            bail!("--thickness must be a positive number of metres, got {t}");
+        if !thickness_collision::limits::is_length(t) {
+            let [lo, hi] = thickness_collision::limits::LENGTH_RANGE;
+            bail!("--thickness {t}: must be from {lo:e} to {hi:e} m");
         }
         params.default_thickness = t;
         params.thin_surfaces.thickness.iter_mut().for_each(|x| *x = t);

@@ -202,7 +202,9 @@ impl Pipeline {
     /// A new robot from URDF text (a `robot_description` message), swapped in whole; on error the
     /// current robot stays. Merged joint positions are dropped when the new robot's joints differ.
     pub fn set_robot_description(&mut self, urdf: &str, source: &str) -> Result<(), CheckerError> {
-        let checker = Checker::from_description(self.params().clone(), urdf, source, self.environment.as_deref())?;
+        let params = self.params().clone();
+        let checker = crate::limits::contain_panic(|| Checker::from_description(params, urdf, source, self.environment.as_deref()))
+            .map_err(CheckerError::Panicked)??;
         self.source = RobotSource::Description { urdf: urdf.into(), source: source.to_owned() };
         self.replace(checker);
         Ok(())
@@ -211,10 +213,11 @@ impl Pipeline {
     /// New parameters: the checker is rebuilt with the robot from the same source (a robot
     /// received as a description stays); on error everything stays as it was.
     pub fn set_params(&mut self, params: Params) -> Result<(), CheckerError> {
-        let checker = match &self.source {
-            RobotSource::Files { robot } => Checker::from_params(params, robot.as_deref(), self.environment.as_deref())?,
-            RobotSource::Description { urdf, source } => Checker::from_description(params, urdf, source, self.environment.as_deref())?,
-        };
+        let checker = crate::limits::contain_panic(|| match &self.source {
+            RobotSource::Files { robot } => Checker::from_params(params, robot.as_deref(), self.environment.as_deref()),
+            RobotSource::Description { urdf, source } => Checker::from_description(params, urdf, source, self.environment.as_deref()),
+        })
+        .map_err(CheckerError::Panicked)??;
         self.replace(checker);
         Ok(())
     }
