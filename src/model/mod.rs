@@ -3,6 +3,7 @@
 
 #[cfg(feature = "testing")]
 pub mod example_workcell;
+pub mod collada_guard;
 pub mod mesh_file;
 mod package;
 mod params;
