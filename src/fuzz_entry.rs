@@ -266,30 +266,27 @@ pub fn mesh_dae(data: &[u8]) {
 /// A sequence of CDR messages (see [`cdr_records`]) decoded as the node decodes them and handed
 /// to a fresh pipeline in order; every state it yields is checked against the workcell.
 pub fn cdr(data: &[u8]) {
-    let records = split_records(data);
-    if records.is_empty() {
-        return;
-    }
-    let mut pipeline = fresh_pipeline();
-    for (kind, payload) in records {
+    // The pipeline (a few milliseconds to build) only once a message decodes.
+    let mut pipeline: Option<Pipeline> = None;
+    for (kind, payload) in split_records(data) {
         match kind {
             CdrKind::JointStates => {
                 if let Ok(msg) = decode_cdr::<JointState>(payload) {
-                    if let Ok(state) = pipeline.joint_state(&msg) {
+                    if let Ok(state) = pipeline.get_or_insert_with(fresh_pipeline).joint_state(&msg) {
                         check_on_workcell(&state);
                     }
                 }
             }
             CdrKind::Tf => {
                 if let Ok(msg) = decode_cdr::<TfMessage>(payload) {
-                    if let Ok(state) = pipeline.tf(&msg) {
+                    if let Ok(state) = pipeline.get_or_insert_with(fresh_pipeline).tf(&msg) {
                         check_on_workcell(&state);
                     }
                 }
             }
             CdrKind::TfStatic => {
                 if let Ok(msg) = decode_cdr::<TfMessage>(payload) {
-                    let _ = pipeline.tf_static(&msg);
+                    let _ = pipeline.get_or_insert_with(fresh_pipeline).tf_static(&msg);
                 }
             }
             CdrKind::Description => {
@@ -308,7 +305,9 @@ pub fn cdr(data: &[u8]) {
                 let _ = decode_cdr::<ClockMsg>(payload);
             }
         }
-        let _ = pipeline.take_warnings();
+        if let Some(p) = pipeline.as_mut() {
+            let _ = p.take_warnings();
+        }
     }
 }
 
@@ -455,7 +454,7 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
     ascii.push_str("endsolid gripper\n");
     out.push(("mesh_stl", "gripper_binary.stl".into(), binary));
     out.push(("mesh_stl", "gripper_ascii.stl".into(), ascii.into_bytes()));
-    let dae = r#"<?xml version="1.0" encoding="utf-8"?>
+    let dae = r##"<?xml version="1.0" encoding="utf-8"?>
 <COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
   <asset><unit meter="1" name="meter"/><up_axis>Z_UP</up_axis></asset>
   <library_geometries>
@@ -469,7 +468,7 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
   <library_visual_scenes><visual_scene id="scene"><node id="n"><instance_geometry url="#quad"/></node></visual_scene></library_visual_scenes>
   <scene><instance_visual_scene url="#scene"/></scene>
 </COLLADA>
-"#;
+"##;
     out.push(("mesh_dae", "quad.dae".into(), dae.as_bytes().to_vec()));
 
     // CDR: every kind the node decodes, alone and in sequences, for the workcell robot.

@@ -1,0 +1,4 @@
+//! Fuzz target `cdr`: see `thickness_collision::fuzz_entry::cdr` and docs/fuzzing.md.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::cdr(data));

@@ -1,0 +1,76 @@
+//! Replays every input saved under `fuzz/regressions/<target>/` (crashes the fuzzer found, and a
+//! few small seeds) through the same entry function its `cargo fuzz` target calls
+//! (`thickness_collision::fuzz_entry`), on stable: none may panic. See docs/fuzzing.md.
+//!
+//! `write_seed_corpus` (ignored) writes the generated seed corpus for `scripts/fuzz_campaign.sh`.
+
+use std::path::{Path, PathBuf};
+use thickness_collision::fuzz_entry::{seeds, TARGETS};
+
+fn regressions_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz").join("regressions")
+}
+
+fn files_in(dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = match std::fs::read_dir(dir) {
+        Ok(entries) => entries.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.is_file()).collect(),
+        Err(_) => Vec::new(),
+    };
+    files.sort();
+    files
+}
+
+#[test]
+fn every_saved_input_replays_without_panic() {
+    let dir = regressions_dir();
+    // A folder that names no target would be skipped silently: refuse it.
+    for entry in std::fs::read_dir(&dir).expect("fuzz/regressions exists") {
+        let name = entry.expect("readable entry").file_name().to_string_lossy().into_owned();
+        assert!(
+            TARGETS.iter().any(|(t, _)| *t == name),
+            "fuzz/regressions/{name} is not a fuzz target (targets: {:?})",
+            TARGETS.iter().map(|t| t.0).collect::<Vec<_>>()
+        );
+    }
+    let mut failed = Vec::new();
+    let mut replayed = 0;
+    for (target, entry) in TARGETS {
+        for file in files_in(&dir.join(target)) {
+            let bytes = std::fs::read(&file).expect("readable input");
+            let started = std::time::Instant::now();
+            if std::panic::catch_unwind(|| entry(&bytes)).is_err() {
+                failed.push(format!("{target}/{}", file.file_name().unwrap_or_default().to_string_lossy()));
+            }
+            replayed += 1;
+            println!("{target}/{}: {:.1} ms", file.file_name().unwrap_or_default().to_string_lossy(), started.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    println!("{replayed} inputs replayed");
+    assert!(replayed > 0, "no inputs under {}", dir.display());
+    assert!(failed.is_empty(), "{} of {replayed} saved fuzz inputs panic: {failed:?}", failed.len());
+}
+
+#[test]
+fn generated_seeds_run_without_panic() {
+    let seeds = seeds();
+    for (target, _) in TARGETS.iter().filter(|(t, _)| !t.starts_with("bag_")) {
+        assert!(seeds.iter().any(|(t, _, _)| t == target), "no generated seed for {target}");
+    }
+    for (target, name, bytes) in &seeds {
+        assert!(!bytes.is_empty(), "seed {target}/{name} is empty");
+        let entry = TARGETS.iter().find(|(t, _)| t == target).map(|(_, e)| *e).expect("a known target");
+        entry(bytes);
+    }
+}
+
+/// Writes the generated seeds to `$FUZZ_CORPUS_DIR/<target>/` (default `fuzz/corpus/`).
+#[test]
+#[ignore = "writes the fuzz seed corpus; run by scripts/fuzz_campaign.sh"]
+fn write_seed_corpus() {
+    let root = std::env::var_os("FUZZ_CORPUS_DIR").map(PathBuf::from).unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz").join("corpus"));
+    for (target, name, bytes) in seeds() {
+        let dir = root.join(target);
+        std::fs::create_dir_all(&dir).expect("corpus directory");
+        std::fs::write(dir.join(format!("seed_{name}")), bytes).expect("seed written");
+    }
+}
