@@ -130,13 +130,7 @@ pub fn diagnostics(
         Some(e) => (ERROR, e.to_owned()),
         None => (if bad > 0 { WARN } else { OK }, counts),
     };
-    let status = DiagnosticStatus {
-        level,
-        name: format!("{node}: collision checks"),
-        message,
-        hardware_id: String::new(),
-        values,
-    };
+    let status = DiagnosticStatus { level, name: format!("{node}: collision checks"), message, hardware_id: String::new(), values };
     stats.last_received = stats.received;
     stats.check_sum = 0.0;
     stats.check_max = 0.0;

@@ -5,8 +5,8 @@ use super::markers::{cell_markers, contact_markers, diagnostics, NodeStats};
 use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
 use super::param_values::{declarations, to_json, READ_ONLY};
 use super::ros_args::RosArgs;
-use crate::model::{Params, PoseSource, ServiceMapping};
 use crate::limits::MAX_DESCRIPTION_BYTES;
+use crate::model::{Params, PoseSource, ServiceMapping};
 use crate::msgs::{CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
 use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause};
 use anyhow::{anyhow, Context as _, Result};
@@ -252,8 +252,9 @@ enum Event {
 const MAX_STATES_PER_TURN: usize = 256;
 
 /// How long a stop request waits for the loop (busy building a robot, say) before the process
-/// exits without it: SIGTERM is honoured within 2 s whatever the loop is doing.
-const STOP_GRACE: Duration = Duration::from_millis(1500);
+/// exits without it: SIGTERM is honoured within 2 s whatever the loop is doing. (Exiting is not
+/// instant either: a process holding gigabytes took 0.6 s to be torn down.)
+const STOP_GRACE: Duration = Duration::from_millis(1000);
 
 /// The node's state between messages.
 struct NodeState {

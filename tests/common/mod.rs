@@ -12,7 +12,22 @@ pub const CYCLONE_LOOPBACK: &str = r#"<CycloneDDS><Domain id="any"><General><Int
 /// Starts the node (`run` with `args`) with loopback-only DDS on `domain` and waits for its
 /// banner; returns the process, its standard output after the banner, and the banner.
 pub fn start_node(args: &[&str], domain: u32) -> (Child, BufReader<ChildStdout>, String) {
-    let mut node = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+    start_node_wrapped(&[], args, domain)
+}
+
+/// [`start_node`] through `wrapper`, a command that ends by exec'ing the node (for example
+/// `unshare -n sh -c 'ip link set lo up && exec "$0" "$@"'`), so the process returned is the node.
+pub fn start_node_wrapped(wrapper: &[&str], args: &[&str], domain: u32) -> (Child, BufReader<ChildStdout>, String) {
+    let bin = env!("CARGO_BIN_EXE_thickness_collision");
+    let mut command = match wrapper.split_first() {
+        Some((first, rest)) => {
+            let mut c = Command::new(first);
+            let _ = c.args(rest).arg(bin);
+            c
+        }
+        None => Command::new(bin),
+    };
+    let mut node = command
         .arg("run")
         .args(args)
         .env("ROS_DOMAIN_ID", domain.to_string())
