@@ -150,6 +150,15 @@ pub fn name_list<S: AsRef<str>>(names: &[S]) -> String {
     s
 }
 
+/// A number as a person would write it in an error: `1e300`, `1e-9`, `0.25`, `NaN`.
+pub fn show_number(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-3..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 /// Whether `v` is a size the core accepts ([`LENGTH_RANGE`]).
 pub fn is_length(v: f64) -> bool {
     (LENGTH_RANGE[0]..=LENGTH_RANGE[1]).contains(&v)

@@ -23,7 +23,7 @@ fn parse_scale(s: &str) -> Result<Vector> {
 pub fn areas(path: PathBuf, thickness: f64, side: Side, scale: &str, json: Option<PathBuf>) -> Result<()> {
     if !thickness_collision::limits::is_length(thickness) {
         let [lo, hi] = thickness_collision::limits::LENGTH_RANGE;
-        bail!("--thickness {thickness}: must be from {lo:e} to {hi:e} m");
+        bail!("--thickness {}: must be from {lo:e} to {hi:e} m", thickness_collision::limits::show_number(thickness));
     }
     let scale = parse_scale(scale)?;
     let data = read_mesh(&path, scale)?;

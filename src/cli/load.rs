@@ -14,7 +14,7 @@ pub fn params(args: &ModelArgs) -> Result<Params> {
     if let Some(t) = args.thickness {
         if !thickness_collision::limits::is_length(t) {
             let [lo, hi] = thickness_collision::limits::LENGTH_RANGE;
-            bail!("--thickness {t}: must be from {lo:e} to {hi:e} m");
+            bail!("--thickness {}: must be from {lo:e} to {hi:e} m", thickness_collision::limits::show_number(t));
         }
         params.default_thickness = t;
         params.thin_surfaces.thickness.iter_mut().for_each(|x| *x = t);

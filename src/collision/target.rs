@@ -135,16 +135,20 @@ impl ConvexHull {
         Self::from_parry(ConvexPolyhedron::from_convex_hull(points)?)
     }
 
-    /// An axis-aligned box `[-half, half]`.
+    /// An axis-aligned box `[-half, half]`. Its faces are given, not found: parry's hull
+    /// algorithm refuses boxes flatter than about 1:1000 (a 100 m x 100 m x 1 cm plate).
     pub fn cuboid(half_extents: Vector) -> Option<ConvexHull> {
         let h = half_extents;
-        if !(h.min_element() > 0.0) {
+        if !(h.min_element() > 0.0) || !h.is_finite() {
             return None;
         }
+        // Corner i has x, y, z positive where bits 0, 1, 2 of i are set.
         let corners: Vec<Vector> = (0..8)
             .map(|i| Vector::new(if i & 1 == 0 { -h.x } else { h.x }, if i & 2 == 0 { -h.y } else { h.y }, if i & 4 == 0 { -h.z } else { h.z }))
             .collect();
-        Self::from_points(&corners)
+        const FACES: [[u32; 3]; 12] =
+            [[0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5], [0, 1, 5], [0, 5, 4], [2, 6, 7], [2, 7, 3], [0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6]];
+        Self::from_parry(ConvexPolyhedron::from_convex_mesh(corners, &FACES)?)
     }
 
     fn from_parry(parry: ConvexPolyhedron) -> Option<ConvexHull> {

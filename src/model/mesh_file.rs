@@ -4,6 +4,7 @@
 //! ASCII); such files are recognised by their size, `84 + 50 n` bytes for `n` triangles, and
 //! parsed here.
 
+use super::collada_guard::check_collada;
 use super::xml_guard::check_xml;
 use crate::limits::{contain_panic, is_coordinate, read_regular, InputFileError, LENGTH_RANGE, MAX_COORDINATE, MAX_MESH_BYTES, MAX_MESH_TRIANGLES};
 use crate::math::{Real, Vector};
@@ -89,7 +90,7 @@ pub fn parse_mesh(bytes: &[u8], path: &Path, scale: Vector) -> Result<MeshData, 
         _ => {
             if format == "dae" {
                 check_xml(bytes).map_err(|e| parse(e.to_string()))?;
-                // PENDING(collada_guard): check_collada(bytes).map_err(parse)?;
+                check_collada(bytes).map_err(parse)?;
             }
             // Materials do not matter to collision: an OBJ's `mtllib` is never opened (it could
             // name a FIFO or a device).
@@ -181,11 +182,7 @@ fn read_binary_stl(bytes: &[u8]) -> Result<MeshData, String> {
     let (header, records) = bytes.split_at(84);
     let declared = u32::from_le_bytes([header[80], header[81], header[82], header[83]]) as u64;
     if records.len() as u64 != 50 * declared {
-        return Err(format!(
-            "binary STL declares {declared} triangles ({} bytes) but has {} bytes after its header",
-            50 * declared,
-            records.len()
-        ));
+        return Err(format!("binary STL declares {declared} triangles ({} bytes) but has {} bytes after its header", 50 * declared, records.len()));
     }
     if declared as usize > MAX_MESH_TRIANGLES {
         return Err(format!("{declared} triangles, more than the {MAX_MESH_TRIANGLES} allowed"));

@@ -207,7 +207,10 @@ impl Params {
         // A parameters file has no use for anchors and aliases; refusing them stops an alias
         // bomb before the parser expands it.
         if let Some((n, _)) = text.lines().enumerate().find(|(_, l)| has_alias(l)) {
-            return Err(ParamsError::Yaml(path.to_owned(), format!("line {}: YAML anchors and aliases (& and *) are not accepted in a parameters file", n + 1)));
+            return Err(ParamsError::Yaml(
+                path.to_owned(),
+                format!("line {}: YAML anchors and aliases (& and *) are not accepted in a parameters file", n + 1),
+            ));
         }
         let doc: serde_yaml_ng::Value = serde_yaml_ng::from_str(text).map_err(|e| ParamsError::Yaml(path.to_owned(), e.to_string()))?;
         let section = ["thickness_collision", "/thickness_collision", "/**"]
@@ -227,7 +230,7 @@ impl Params {
         }
         let [lo, hi] = crate::limits::LENGTH_RANGE;
         if !crate::limits::is_length(self.default_thickness) {
-            return bad("default_thickness", format!("must be from {lo:e} to {hi:e} m, got {:?}", self.default_thickness));
+            return bad("default_thickness", format!("must be from {lo:e} to {hi:e} m, got {}", crate::limits::show_number(self.default_thickness)));
         }
         if let Some(v) = self.robot_base_pose.iter().take(3).find(|v| !crate::limits::is_coordinate(**v)) {
             return bad("robot_base_pose", format!("x, y and z must be within {:e} m, got {v:?}", crate::limits::MAX_COORDINATE));
@@ -240,7 +243,7 @@ impl Params {
             return bad("thin_surfaces.side", format!("has {} values for {} patterns", ts.side.len(), ts.patterns.len()));
         }
         if let Some(t) = ts.thickness.iter().find(|t| !crate::limits::is_length(**t)) {
-            return bad("thin_surfaces.thickness", format!("must be from {lo:e} to {hi:e} m, got {t:?}"));
+            return bad("thin_surfaces.thickness", format!("must be from {lo:e} to {hi:e} m, got {}", crate::limits::show_number(*t)));
         }
         if self.padding.values.len() != self.padding.links.len() {
             return bad("padding.values", format!("has {} values for {} link patterns", self.padding.values.len(), self.padding.links.len()));

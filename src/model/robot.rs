@@ -3,7 +3,9 @@
 
 use super::package::{PackageError, PackageResolver};
 use super::xml_guard::{check_xml, for_each_tag, Tag};
-use crate::limits::{contain_panic, is_coordinate, is_length, name_list, read_regular_text, InputFileError, LENGTH_RANGE, MAX_COORDINATE, MAX_DESCRIPTION_BYTES};
+use crate::limits::{
+    contain_panic, is_coordinate, is_length, name_list, read_regular_text, InputFileError, LENGTH_RANGE, MAX_COORDINATE, MAX_DESCRIPTION_BYTES,
+};
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -169,7 +171,7 @@ pub enum ModelError {
         message: String,
     },
     /// A number in the URDF is NaN, infinite or out of its domain.
-    #[error("{file}: {what} has an invalid value {value}")]
+    #[error("{file}: {what} has an invalid value {}", crate::limits::show_number(*.value))]
     Value {
         /// File.
         file: String,
@@ -418,7 +420,11 @@ impl RobotModel {
                 let (multiplier, offset) = (m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0));
                 for (what, v) in [("multiplier", multiplier), ("offset", offset)] {
                     if !(v.is_finite() && v.abs() <= MAX_COORDINATE) {
-                        return Err(ModelError::Value { file: file.into(), what: format!("joint '{}' mimic {what} (allowed: finite, |x| <= {MAX_COORDINATE:e})", j.name), value: v });
+                        return Err(ModelError::Value {
+                            file: file.into(),
+                            what: format!("joint '{}' mimic {what} (allowed: finite, |x| <= {MAX_COORDINATE:e})", j.name),
+                            value: v,
+                        });
                     }
                 }
                 joints[i].mimic = Some(Mimic { joint: target, multiplier, offset });

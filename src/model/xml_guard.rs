@@ -45,8 +45,9 @@ pub fn check_xml(text: &[u8]) -> Result<(), XmlGuardError> {
     while let Some(off) = text.get(i..).and_then(|t| t.iter().position(|&b| b == b'<')) {
         let start = i + off;
         let rest = &text[start..];
-        let skip_to =
-            |end: &[u8], what: &'static str| find(text, start, end).map(|p| p + end.len()).ok_or(XmlGuardError::Unterminated { line: line_at(start), what });
+        let skip_to = |end: &[u8], what: &'static str| {
+            find(text, start, end).map(|p| p + end.len()).ok_or_else(|| XmlGuardError::Unterminated { line: line_at(start), what })
+        };
         if rest.starts_with(b"<!--") {
             i = skip_to(b"-->", "comment")?;
         } else if rest.starts_with(b"<![CDATA[") {
@@ -73,7 +74,7 @@ pub fn check_xml(text: &[u8]) -> Result<(), XmlGuardError> {
                     _ => {}
                 }
             }
-            let end = end.ok_or(XmlGuardError::Unterminated { line: line_at(start), what: "tag" })?;
+            let end = end.ok_or_else(|| XmlGuardError::Unterminated { line: line_at(start), what: "tag" })?;
             if rest[end - 1] != b'/' {
                 depth += 1;
                 if depth > MAX_XML_DEPTH {
