@@ -252,9 +252,11 @@ impl Checker {
                 let pose = pose_from_isometry(&(env_poses[li] * g.origin));
                 match &g.spec {
                     GeometrySpec::Mesh { path, scale } => {
-                        let data = cache
-                            .get(path, *scale)
-                            .map_err(|error| CheckerError::Mesh { file: summary.environment_source.clone(), link: link.name.clone(), error })?;
+                        let data = cache.get(path, *scale).map_err(|error| CheckerError::Mesh {
+                            file: summary.environment_source.clone(),
+                            link: link.name.clone(),
+                            error,
+                        })?;
                         let geo = |message: String| CheckerError::Geometry {
                             file: summary.environment_source.clone(),
                             link: link.name.clone(),
@@ -302,8 +304,11 @@ impl Checker {
             for g in &link.geometry {
                 let shape = match &g.spec {
                     GeometrySpec::Mesh { path, scale } => {
-                        let data =
-                            cache.get(path, *scale).map_err(|error| CheckerError::Mesh { file: summary.robot_source.clone(), link: link.name.clone(), error })?;
+                        let data = cache.get(path, *scale).map_err(|error| CheckerError::Mesh {
+                            file: summary.robot_source.clone(),
+                            link: link.name.clone(),
+                            error,
+                        })?;
                         let geo = |message: &str| CheckerError::Geometry {
                             file: summary.robot_source.clone(),
                             link: link.name.clone(),

@@ -1,9 +1,9 @@
 //! Files turned into the plain data the core takes: URDF robots and environments, mesh files,
 //! `package://` URIs, the parameters file, and forward kinematics.
 
+pub mod collada_guard;
 #[cfg(feature = "testing")]
 pub mod example_workcell;
-pub mod collada_guard;
 pub mod mesh_file;
 mod package;
 mod params;

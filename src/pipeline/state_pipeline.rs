@@ -203,8 +203,8 @@ impl Pipeline {
     /// current robot stays. Merged joint positions are dropped when the new robot's joints differ.
     pub fn set_robot_description(&mut self, urdf: &str, source: &str) -> Result<(), CheckerError> {
         let params = self.params().clone();
-        let checker = crate::limits::contain_panic(|| Checker::from_description(params, urdf, source, self.environment.as_deref()))
-            .map_err(CheckerError::Panicked)??;
+        let checker =
+            crate::limits::contain_panic(|| Checker::from_description(params, urdf, source, self.environment.as_deref())).map_err(CheckerError::Panicked)??;
         self.source = RobotSource::Description { urdf: urdf.into(), source: source.to_owned() };
         self.replace(checker);
         Ok(())

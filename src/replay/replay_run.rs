@@ -140,7 +140,11 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
         PoseSource::Tf => "tf2_msgs/msg/TFMessage",
     };
     if let Some((_, ty)) = bag.topics().iter().find(|(t, ty)| *t == topic && !ty.is_empty() && ty != expected) {
-        bail!("topic {topic} in bag {} has type {ty}; pose_source {} reads {expected}", opts.bag.display(), if pose_source == PoseSource::Tf { "tf" } else { "joint_states" });
+        bail!(
+            "topic {topic} in bag {} has type {ty}; pose_source {} reads {expected}",
+            opts.bag.display(),
+            if pose_source == PoseSource::Tf { "tf" } else { "joint_states" }
+        );
     }
     // Both doors start with the robot the parameters name; a description in the bag replaces it
     // at its log time, as it would replace it in the running node.
