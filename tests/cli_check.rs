@@ -147,7 +147,7 @@ fn bad_input_is_a_clear_error() {
     // A JSON line that is not a state, and unequal lengths.
     let states = tmp("bad.jsonl");
     std::fs::write(&states, "{\"name\": [\"elbow_joint\"], \"position\": [0.1]}\n{\"hello\": 1}\n").unwrap();
-    err(bin().args(["check", "--states", states.to_str().unwrap()]).output().unwrap(), &["bad.jsonl", "line 2", "not a state"]);
+    err(bin().args(["check", "--states", states.to_str().unwrap()]).output().unwrap(), &["bad.jsonl", "line 2", "keys [hello]", "expected {\"name\""]);
     std::fs::write(&states, "{\"name\": [\"elbow_joint\"], \"position\": [0.1, 0.2]}\n").unwrap();
     err(bin().args(["check", "--states", states.to_str().unwrap()]).output().unwrap(), &["line 1", "1 names but 2 positions"]);
     // missing_joint: reject.
