@@ -92,6 +92,17 @@ pub fn parse_mesh(bytes: &[u8], path: &Path, scale: Vector) -> Result<MeshData, 
                 check_xml(bytes).map_err(|e| parse(e.to_string()))?;
                 check_collada(bytes).map_err(parse)?;
             }
+            if format == "obj" {
+                // Counted before mesh-loader allocates them.
+                let triangles: usize = bytes
+                    .split(|&b| b == b'\n')
+                    .filter(|l| l.starts_with(b"f ") || l.starts_with(b"f\t"))
+                    .map(|l| l.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty()).count().saturating_sub(3))
+                    .sum();
+                if triangles > MAX_MESH_TRIANGLES {
+                    return Err(parse(format!("{triangles} triangles, more than the {MAX_MESH_TRIANGLES} allowed")));
+                }
+            }
             // Materials do not matter to collision: an OBJ's `mtllib` is never opened (it could
             // name a FIFO or a device).
             let no_materials = |_: &Path| -> std::io::Result<Vec<u8>> { Err(std::io::Error::other("material files are not read")) };
