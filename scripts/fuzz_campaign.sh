@@ -46,7 +46,8 @@ if [ -d "$VENV" ]; then
     for ext in urdf:urdf stl:mesh_stl dae:mesh_dae obj:mesh_obj; do
         suffix=${ext%%:*} target=${ext##*:}
         mkdir -p "fuzz/corpus/$target"
-        find "$VENV" -path '*example-robot-data*' -name "*.$suffix" -size -64k 2>/dev/null | head -n 40 | while read -r f; do
+        mapfile -t found < <(find "$VENV" -path '*example-robot-data*' -name "*.$suffix" -size -64k 2>/dev/null | sort)
+        for f in "${found[@]:0:40}"; do
             cp "$f" "fuzz/corpus/$target/erd_$(echo "$f" | md5sum | cut -c1-12).$suffix"
         done
     done

@@ -31,9 +31,12 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 
+/// A target's entry: raw bytes in, nothing out, never a panic.
+pub type Entry = fn(&[u8]);
+
 /// Every target: its name (the `fuzz/fuzz_targets/<name>.rs` file and the
 /// `fuzz/regressions/<name>/` folder) and its entry.
-pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+pub const TARGETS: &[(&str, Entry)] = &[
     ("urdf", urdf),
     ("mesh_stl", mesh_stl),
     ("mesh_obj", mesh_obj),
@@ -499,7 +502,8 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
     let description = StringMsg { data: shapes.into() };
     let request = CheckStatesRequest { states: vec![full.clone(), partial.clone()] };
     let clock = ClockMsg { clock: Time { sec: 5, nanosec: 6 } };
-    let cdr_seeds: [(&str, Vec<(CdrKind, Vec<u8>)>); 7] = [
+    type Records = Vec<(CdrKind, Vec<u8>)>;
+    let cdr_seeds: [(&str, Records); 7] = [
         ("joint_state", vec![(CdrKind::JointStates, encode_cdr_le(&full))]),
         ("joint_states_merged", vec![(CdrKind::JointStates, encode_cdr_le(&full)), (CdrKind::JointStates, encode_cdr_le(&partial))]),
         ("tf", vec![(CdrKind::TfStatic, encode_cdr_le(&tf_static)), (CdrKind::Tf, encode_cdr_le(&tf))]),
