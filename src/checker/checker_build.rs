@@ -1,6 +1,7 @@
 //! Loading the robot and the environment and checking states against them.
 
 use super::joint_state::{resolve_positions, StateError};
+use super::motion::MotionBounds;
 use super::state_report::{ReportContact, StateReport};
 use crate::collision::{CollideSettings, ConvexHull, Scene, Target, TargetShape};
 use crate::math::{pose_from_isometry, Pose, Vector};
@@ -103,6 +104,8 @@ pub struct Checker {
     base: Isometry3<f64>,
     /// `allowed[target index][object index]`.
     allowed: Vec<Vec<bool>>,
+    /// Levers and grown parts for motion checks, built on the first motion.
+    motion: std::sync::OnceLock<MotionBounds>,
 }
 
 /// Mesh files read once per build.
@@ -171,6 +174,21 @@ impl Checker {
     /// What was loaded.
     pub fn summary(&self) -> &BuildSummary {
         &self.summary
+    }
+
+    /// The pose of the robot's root link in the world (`robot_base_pose`).
+    pub fn base_pose(&self) -> &Isometry3<f64> {
+        &self.base
+    }
+
+    pub(crate) fn motion_bounds(&self) -> &MotionBounds {
+        self.motion.get_or_init(|| MotionBounds::new(&self.robot, &self.targets, self.params.motion_tolerance))
+    }
+
+    /// Target `ti` (a part of a checked link, posed) against the scene, without the objects the
+    /// link may touch.
+    pub(crate) fn collide_target(&self, ti: usize, target: &Target, settings: &CollideSettings) -> crate::collision::TargetReport {
+        self.scene.collide_filtered(target, settings, |oi| !self.allowed[ti][oi])
     }
 
     /// Loads the robot and the environment named by the parameters (or the overrides), with
@@ -335,7 +353,7 @@ impl Checker {
         summary.meshes_read = cache.meshes.len();
         summary.build_seconds = started.elapsed().as_secs_f64();
         let base = base_isometry(&params.robot_base_pose);
-        Ok(Checker { params, robot, targets, scene, summary, base, allowed })
+        Ok(Checker { params, robot, targets, scene, summary, base, allowed, motion: std::sync::OnceLock::new() })
     }
 
     /// Checks a joint state given by name, on its own: an unknown name is an error, and a joint

@@ -5,8 +5,10 @@
 
 mod checker_build;
 mod joint_state;
+mod motion;
 mod state_report;
 
 pub use self::checker_build::{BuildSummary, Checker, CheckerError, LinkTargets};
 pub use self::joint_state::StateError;
+pub use self::motion::{MotionReport, MAX_SUBINTERVALS};
 pub use self::state_report::{ReportContact, StateReport};

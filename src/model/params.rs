@@ -127,6 +127,9 @@ pub struct Params {
     pub use_sim_time: bool,
     /// Request/reply mapping of the node's services.
     pub service_mapping: ServiceMapping,
+    /// A motion is reported colliding when a pose along it comes within this distance of a cell
+    /// or solid, and free only when no pose does (metres).
+    pub motion_tolerance: f64,
 }
 
 impl Default for Params {
@@ -152,6 +155,7 @@ impl Default for Params {
             marker_rate: 10.0,
             use_sim_time: false,
             service_mapping: ServiceMapping::Cyclone,
+            motion_tolerance: 0.001,
         }
     }
 }
@@ -247,6 +251,9 @@ impl Params {
         }
         if self.padding.values.len() != self.padding.links.len() {
             return bad("padding.values", format!("has {} values for {} link patterns", self.padding.values.len(), self.padding.links.len()));
+        }
+        if !(1e-6..=0.1).contains(&self.motion_tolerance) {
+            return bad("motion_tolerance", format!("must be from 1e-6 to 0.1 m, got {}", crate::limits::show_number(self.motion_tolerance)));
         }
         if let Some(p) = self.padding.values.iter().find(|p| !(**p >= 0.0 && **p <= hi)) {
             return bad("padding.values", format!("must be from 0 to {hi:e} m, got {p:?}"));
