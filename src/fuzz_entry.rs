@@ -97,7 +97,8 @@ pub fn cdr_records(records: &[(CdrKind, Vec<u8>)]) -> Vec<u8> {
     out
 }
 
-fn split_records(mut data: &[u8]) -> Vec<(CdrKind, &[u8])> {
+/// The records of a [`cdr`] input, as the target reads them.
+pub fn split_records(mut data: &[u8]) -> Vec<(CdrKind, &[u8])> {
     let mut out = Vec::new();
     while let [kind, rest @ ..] = data {
         let kind = CDR_KINDS[*kind as usize % CDR_KINDS.len()];

@@ -74,3 +74,36 @@ fn write_seed_corpus() {
         std::fs::write(dir.join(format!("seed_{name}")), bytes).expect("seed written");
     }
 }
+
+/// The seeds reach past the decoders: the CDR joint state and `/tf` seeds give states the
+/// bundled robot can check, and the state-line seeds are checked without an error.
+#[test]
+fn seeds_reach_checked_states() {
+    use thickness_collision::fuzz_entry::{split_records, CdrKind};
+    use thickness_collision::model::Params;
+    use thickness_collision::msgs::{JointState, TfMessage};
+    use thickness_collision::pipeline::{parse_state_line, Pipeline};
+    use thickness_collision::replay::decode_cdr;
+    let seeds = seeds();
+    let seed = |target: &str, name: &str| seeds.iter().find(|(t, n, _)| *t == target && n == name).map(|s| s.2.clone()).expect("a seed");
+    let mut pipeline = Pipeline::new(Params::default(), None, None).expect("the bundled workcell");
+
+    let input = seed("cdr", "joint_state.cdr");
+    let records = split_records(&input);
+    assert_eq!(records[0].0, CdrKind::JointStates);
+    let state = pipeline.joint_state(&decode_cdr::<JointState>(records[0].1).expect("decodes")).expect("a state");
+    assert!(pipeline.check(&state).report.error.is_empty());
+
+    let input = seed("cdr", "tf.cdr");
+    let records = split_records(&input);
+    assert_eq!((records[0].0, records[1].0), (CdrKind::TfStatic, CdrKind::Tf));
+    pipeline.tf_static(&decode_cdr::<TfMessage>(records[0].1).expect("decodes")).expect("applied");
+    let state = pipeline.tf(&decode_cdr::<TfMessage>(records[1].1).expect("decodes")).expect("a state");
+    assert!(pipeline.check(&state).report.error.is_empty());
+
+    for name in ["joints.json", "transforms.json"] {
+        let line = seed("state_line", name);
+        let checked = pipeline.check_line(parse_state_line(std::str::from_utf8(&line).expect("UTF-8")).expect("a state line"));
+        assert!(checked.report.error.is_empty(), "{name}: {}", checked.report.error);
+    }
+}
