@@ -130,7 +130,7 @@ impl MotionBounds {
     }
 
     fn growth(&self, level: usize) -> Real {
-        self.base * (2.0 as Real).powi(level as i32)
+        self.base * Real::powi(2.0, level as i32)
     }
 }
 

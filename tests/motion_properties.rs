@@ -1,0 +1,129 @@
+//! Issue 12: motions of the Panda (example-robot-data) among the bundled workcell's thin surfaces,
+//! against an oracle that samples every motion densely: every point of the arm moves less than
+//! 1 mm between samples (a bound of 1.2 m from any joint axis to any point of the arm downstream,
+//! checked below). Each sample is checked by the discrete checker (itself proven against parry's GJK over
+//! 500,000 pairs in tests/sat_oracle.rs); a near miss is measured with parry's GJK distance.
+//!
+//! For every motion:
+//! - a motion with a colliding sample is never reported free;
+//! - no colliding sample lies before the reported fraction minus one step;
+//! - a motion reported colliding has a sample within `motion_tolerance` plus one step of the
+//!   object it names (a colliding sample, or parry's distance from the link to the named cell).
+
+mod common;
+
+use oorandom::Rand64;
+use parry3d_f64::query;
+use parry3d_f64::shape::ConvexPolyhedron;
+use thickness_collision::checker::Checker;
+use thickness_collision::collision::{ObjectBody, TargetShape};
+use thickness_collision::math::pose_from_isometry;
+use thickness_collision::model::Params;
+
+const REACH: f64 = 1.2;
+const STEP: f64 = 1e-3;
+const MOTIONS: usize = 2_000;
+
+fn panda() -> Checker {
+    let erd = common::example_robot_data();
+    let params = Params {
+        package_map: vec![format!("example-robot-data={}", erd.display())],
+        // Raised 5 mm off the table it stands on (a link resting on the table collides with it).
+        robot_base_pose: vec![0.0, 0.0, 0.005, 0.0, 0.0, 0.0],
+        ..Params::default()
+    };
+    Checker::from_params(params, Some(&erd.join("robots/panda_description/urdf/panda.urdf")), None).unwrap()
+}
+
+#[test]
+fn motions_agree_with_dense_sampling() {
+    let c = panda();
+    let robot = c.robot();
+    // The bound the oracle's step rests on, in every configuration: from a joint's axis to a
+    // point of a link downstream, at most the joint origins' distances along the chain plus the
+    // point's distance from its link's origin.
+    for t in c.targets() {
+        let reach = t.parts.iter().map(|(shape, offset)| match shape {
+            TargetShape::Polytope(h) => h.points().iter().map(|p| (*offset * *p).length()).fold(0.0, f64::max),
+            other => panic!("Panda links are meshes, not {other:?}"),
+        });
+        let mut chain = reach.fold(0.0, f64::max);
+        let mut link = t.link;
+        while let Some(j) = robot.joints.iter().find(|j| j.child == link) {
+            assert!(chain < REACH, "{} reaches {chain} m from joint {}", t.name, j.name);
+            chain += j.origin.translation.vector.norm();
+            link = j.parent;
+        }
+    }
+
+    let arm: Vec<usize> = (1..=7).map(|i| robot.joint(&format!("panda_joint{i}")).unwrap()).collect();
+    let mut rng = Rand64::new(12);
+    let (mut colliding, mut free, mut near_misses, mut samples) = (0, 0, 0, 0usize);
+    for m in 0..MOTIONS {
+        let mut q0 = vec![0.0; robot.joints.len()];
+        let mut q1 = q0.clone();
+        for &j in &arm {
+            let [lo, hi] = robot.joints[j].limits;
+            let a = lo + (hi - lo) * rng.rand_float();
+            let d = (0.05 + 0.45 * rng.rand_float()) * if rng.rand_u64() % 2 == 0 { 1.0 } else { -1.0 };
+            q0[j] = a;
+            q1[j] = (a + d).clamp(lo, hi);
+        }
+        let r = c.check_motion(&q0, &q1);
+        assert!(r.report.error.is_empty(), "motion {m}: {}", r.report.error);
+        let total: f64 = arm.iter().map(|&j| (q1[j] - q0[j]).abs()).sum();
+        let n = ((REACH * total / STEP).ceil() as usize).max(1);
+        samples += n + 1;
+        let at = |s: f64| -> Vec<f64> { q0.iter().zip(&q1).map(|(a, b)| a + s * (b - a)).collect() };
+        let first_hit = (0..=n).map(|k| k as f64 / n as f64).find(|&s| c.check_positions(&at(s)).unwrap().in_collision);
+        if let Some(s) = first_hit {
+            assert!(r.report.in_collision, "motion {m}: reported free, but the sample at s = {s} collides");
+            let f = r.fraction.unwrap();
+            assert!(s >= f - 1.0 / n as f64, "motion {m}: a colliding sample at {s}, before the reported fraction {f}");
+        }
+        if !r.report.in_collision {
+            free += 1;
+            continue;
+        }
+        colliding += 1;
+        let f = r.fraction.unwrap();
+        if first_hit.is_some_and(|s| s <= f + 2.0 / n as f64) {
+            continue;
+        }
+        // A near miss: the named link came within the tolerance of the named object.
+        near_misses += 1;
+        let contact = r.report.contacts.first().unwrap_or_else(|| panic!("motion {m}: colliding without a contact"));
+        let ti = c.targets().iter().position(|t| t.name == contact.link_name).unwrap();
+        let object = c.scene().objects().iter().find(|o| o.name == contact.object_name).unwrap();
+        let other: Box<dyn parry3d_f64::shape::Shape> = match &object.body {
+            ObjectBody::Surface { area, .. } => {
+                let cell = area.cells.iter().find(|cell| cell.triangle == contact.triangle).unwrap();
+                Box::new(ConvexPolyhedron::from_convex_hull(&cell.distinct_vertices()).unwrap())
+            }
+            ObjectBody::Solid(shape) => match shape {
+                TargetShape::Polytope(h) => Box::new(h.as_parry().clone()),
+                other => panic!("unexpected solid {other:?}"),
+            },
+        };
+        let mut nearest = f64::INFINITY;
+        let k0 = ((f * n as f64).floor() as usize).saturating_sub(1);
+        for k in k0..=(k0 + 3).min(n) {
+            let poses = robot.forward_kinematics(&at(k as f64 / n as f64), c.base_pose()).unwrap();
+            let link = pose_from_isometry(&poses[c.targets()[ti].link]);
+            for (shape, offset) in &c.targets()[ti].parts {
+                let TargetShape::Polytope(h) = shape else { unreachable!() };
+                let d = query::distance(&(link * *offset), h.as_parry(), &object.pose, &*other).unwrap();
+                nearest = nearest.min(d.distance);
+            }
+        }
+        let tol = c.params().motion_tolerance;
+        assert!(
+            nearest <= tol + STEP,
+            "motion {m}: reported colliding at {f}, but {} stays {nearest} m from {} (tolerance {tol})",
+            contact.link_name,
+            contact.object_name
+        );
+    }
+    eprintln!("{MOTIONS} Panda motions, {samples} oracle samples: {colliding} colliding ({near_misses} near misses), {free} free");
+    assert!(colliding > MOTIONS / 10 && free > MOTIONS / 10, "the sample must have both outcomes");
+}
