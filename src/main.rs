@@ -59,6 +59,11 @@ enum Command {
         /// One JSON object per state on standard output.
         #[arg(long)]
         json: bool,
+        /// The states file is one path: the first line is checked as a state, every further line
+        /// as the motion from the previous line's state to its own (nothing crossed in between
+        /// is missed; see `motion_tolerance`).
+        #[arg(long, requires = "states")]
+        motion: bool,
         /// Print the parameters in force as a ROS 2 parameters file and exit.
         #[arg(long)]
         show_params: bool,
@@ -137,7 +142,9 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Areas { mesh, thickness, side, scale, json } => cli::areas::areas(mesh, thickness, side, &scale, json),
-        Command::Check { model, joints, states, json, show_params } => cli::check::check(&model, joints.as_deref(), states.as_deref(), json, show_params),
+        Command::Check { model, joints, states, json, motion, show_params } => {
+            cli::check::check(&model, joints.as_deref(), states.as_deref(), json, motion, show_params)
+        }
         #[cfg(feature = "ros")]
         Command::Run { model, ros_args } => cli::run::run(&model, &ros_args),
         Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, jsonl, start, end } => {

@@ -25,7 +25,7 @@ fn msg_and_srv_files_parse_with_rosbags() {
     assert_eq!(fields, ["link_name", "object_name", "triangle", "depth", "position", "normal"]);
     let report = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/interfaces/thickness_collision_msgs/msg/CollisionReport.msg")).unwrap();
     let fields: Vec<&str> = report.lines().filter_map(|l| l.split('#').next()).filter_map(|l| l.split_whitespace().nth(1)).collect();
-    assert_eq!(fields, ["header", "in_collision", "contacts", "check_seconds", "error"]);
+    assert_eq!(fields, ["header", "in_collision", "contacts", "check_seconds", "error", "motion", "fraction"]);
     let c = thickness_collision::msgs::ContactMsg::default();
     let v = serde_json::to_value(&c).unwrap();
     let keys: Vec<&String> = v.as_object().unwrap().keys().collect();

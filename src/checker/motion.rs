@@ -142,7 +142,7 @@ impl Checker {
         let robot = self.robot();
         for q in [q0, q1] {
             if let Err(e) = robot.forward_kinematics(q, &nalgebra::Isometry3::identity()) {
-                return MotionReport { report: StateReport::failed(e.to_string()), ..Default::default() };
+                return MotionReport { report: StateReport { motion: true, ..StateReport::failed(e.to_string()) }, ..Default::default() };
             }
         }
         // Joint-space step of every joint (mimics from their master).
@@ -180,8 +180,8 @@ impl Checker {
             examined += 1;
             if examined > MAX_SUBINTERVALS {
                 let mut report = StateReport::failed(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"));
-                report.check_seconds = 0.0;
-                return MotionReport { report, fraction: Some(a), subintervals: examined };
+                report.motion = true;
+                return MotionReport { report, fraction: None, subintervals: examined };
             }
             let m = 0.5 * (a + b);
             let poses = match robot.forward_kinematics(&at(m), self.base_pose()) {
@@ -209,7 +209,7 @@ impl Checker {
                 stack.push((a, m, split));
             }
         }
-        MotionReport { report: StateReport::default(), fraction: None, subintervals: examined }
+        MotionReport { report: StateReport { motion: true, ..Default::default() }, fraction: None, subintervals: examined }
     }
 
     /// Target `ti`'s part `pi` grown by ladder `level` (as it is for `None`).
@@ -257,6 +257,8 @@ impl Checker {
             }
         }
         report.in_collision = true;
+        report.motion = true;
+        report.fraction = Some(fraction);
         MotionReport { report, fraction: Some(fraction), subintervals: examined }
     }
 }

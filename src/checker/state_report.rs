@@ -35,6 +35,13 @@ pub struct StateReport {
     /// Why the state could not be checked; empty when it was.
     #[serde(default)]
     pub error: String,
+    /// The report covers a motion (from the previous state to this one), not one state.
+    #[serde(default)]
+    pub motion: bool,
+    /// For a motion in collision: the first contact along it, in [0, 1] (the start of the first
+    /// stretch that could not be cleared, never later than the true first contact).
+    #[serde(default)]
+    pub fraction: Option<f64>,
     /// Seconds spent checking (not part of `check --json`, which must be deterministic).
     #[serde(skip)]
     pub check_seconds: f64,

@@ -24,7 +24,7 @@ fn parse_joints(spec: &str) -> Result<(Vec<String>, Vec<f64>)> {
     Ok((names, values))
 }
 
-pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json: bool, show_params: bool) -> Result<()> {
+pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json: bool, motion: bool, show_params: bool) -> Result<()> {
     if show_params {
         print!("{}", super::load::params(args)?.to_yaml());
         return Ok(());
@@ -59,6 +59,7 @@ pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json
         };
         let mut reader = std::io::BufReader::new(source);
         let mut first_bad: Option<(usize, String)> = None;
+        let mut previous = None;
         let mut line = Vec::new();
         for n in 1.. {
             line.clear();
@@ -76,7 +77,24 @@ pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json
                 continue;
             }
             let state = parse_state_line(text).map_err(|e| anyhow!("{name}: line {n}: {e}"))?;
-            let checked = pipeline.check_line(state);
+            let checked = if motion {
+                // A waypoint that cannot be checked fails closed, and the next motion starts
+                // from the last good waypoint.
+                let (stamp, result) = pipeline.line_state(state);
+                match result {
+                    Ok(state) => {
+                        let checked = match &previous {
+                            Some(from) => pipeline.check_motion(from, &state),
+                            None => pipeline.check(&state),
+                        };
+                        previous = Some(state);
+                        checked
+                    }
+                    Err(skip) => CheckedState { stamp, report: thickness_collision::checker::StateReport::failed(skip.message) },
+                }
+            } else {
+                pipeline.check_line(state)
+            };
             for w in pipeline.take_warnings() {
                 eprintln!("thickness_collision: warning: {w}");
             }
@@ -105,11 +123,21 @@ fn emit(out: &mut impl Write, n: usize, checked: &CheckedState, json: bool) -> R
         return Ok(());
     }
     let limits = if report.out_of_limits.is_empty() { String::new() } else { format!(" (outside limits: {})", report.out_of_limits.join(", ")) };
-    if !report.in_collision {
+    if report.motion {
+        match report.fraction {
+            None => writeln!(out, "motion to state {n}: clear")?,
+            Some(f) => writeln!(out, "motion to state {n}: IN COLLISION from {f:.4} of the way")?,
+        }
+        if !report.in_collision {
+            return Ok(());
+        }
+    } else if !report.in_collision {
         writeln!(out, "state {n}: clear{limits}")?;
         return Ok(());
     }
-    writeln!(out, "state {n}: IN COLLISION{limits}")?;
+    if !report.motion {
+        writeln!(out, "state {n}: IN COLLISION{limits}")?;
+    }
     for c in &report.contacts {
         let tri = if c.triangle == u32::MAX { "solid".to_string() } else { format!("triangle {}", c.triangle) };
         let point = c.position.map_or("none".into(), |p| format!("[{:.4}, {:.4}, {:.4}]", p[0], p[1], p[2]));

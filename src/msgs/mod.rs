@@ -154,6 +154,10 @@ pub struct CollisionReport {
     pub check_seconds: f64,
     /// Why the state could not be checked (then `in_collision` is true); empty when it was.
     pub error: String,
+    /// The report covers a motion from the previous state to this one.
+    pub motion: bool,
+    /// The first contact along the motion in [0, 1] when `motion` and `in_collision`; else -1.
+    pub fraction: f64,
 }
 
 /// `std_msgs/msg/ColorRGBA`.

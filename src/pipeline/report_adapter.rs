@@ -55,5 +55,7 @@ pub fn report_message(report: &StateReport, stamp: Time, frame: &str) -> Collisi
         contacts: report.contacts.iter().map(contact).collect(),
         check_seconds: report.check_seconds,
         error: report.error.clone(),
+        motion: report.motion,
+        fraction: report.fraction.filter(|_| report.motion && report.in_collision).unwrap_or(-1.0),
     }
 }

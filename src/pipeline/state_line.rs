@@ -1,7 +1,7 @@
 //! One line of a `check --states` file (JSON lines): a joint state or a set of link transforms,
 //! turned into the message the node would receive and put through the pipeline.
 
-use super::{CheckedState, Pipeline};
+use super::{CheckedState, Pipeline, RobotState};
 use crate::checker::StateReport;
 use crate::msgs::{Header, JointState, Quaternion, TfMessage, Time, Transform, TransformStamped, Vector3};
 use serde::Deserialize;
@@ -93,7 +93,16 @@ impl Pipeline {
     /// Checks a states-file line as the node checks the message it stands for; a state the
     /// pipeline cannot check fails closed in its place (`in_collision` and `error`).
     pub fn check_line(&mut self, state: StateLine) -> CheckedState {
-        let (stamp, result) = match state {
+        let (stamp, result) = self.line_state(state);
+        match result {
+            Ok(state) => self.check(&state),
+            Err(skip) => CheckedState { stamp, report: StateReport::failed(skip.message) },
+        }
+    }
+
+    /// The state a line stands for (through the pipeline: merged, validated), or why there is none.
+    pub fn line_state(&mut self, state: StateLine) -> (Time, Result<RobotState, super::Skip>) {
+        match state {
             StateLine::Joints { name, position, stamp } => {
                 let stamp = Time::from_nanos(stamp);
                 let msg = JointState { header: Header { stamp, frame_id: String::new() }, name, position, ..Default::default() };
@@ -115,10 +124,6 @@ impl Pipeline {
                     .collect();
                 (stamp, self.tf(&TfMessage { transforms }))
             }
-        };
-        match result {
-            Ok(state) => self.check(&state),
-            Err(skip) => CheckedState { stamp, report: StateReport::failed(skip.message) },
         }
     }
 }

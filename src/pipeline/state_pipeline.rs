@@ -182,6 +182,17 @@ impl Pipeline {
         CheckedState { stamp: state.stamp, report: result.unwrap_or_else(|e| StateReport::failed(e.to_string())) }
     }
 
+    /// Checks the motion from `from` to `to` (both joint states of the current robot): the
+    /// straight line in joint space, with nothing crossed unseen. A motion between link poses
+    /// (`/tf` input) is not checked yet and fails closed.
+    pub fn check_motion(&self, from: &RobotState, to: &RobotState) -> CheckedState {
+        let report = match (&from.pose, &to.pose) {
+            (StatePose::Joints(a), StatePose::Joints(b)) => self.checker.check_motion(a, b).report,
+            _ => StateReport { motion: true, ..StateReport::failed("a motion between link poses (transforms) is not checked yet; check joint states") },
+        };
+        CheckedState { stamp: to.stamp, report }
+    }
+
     /// A `check_states` request: every state on its own, every name a joint of the robot; one
     /// report per state, in order, a state that cannot be checked failing closed in its slot.
     /// Checked on all cores with the `parallel` feature.
