@@ -29,6 +29,9 @@ pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json
         print!("{}", super::load::params(args)?.to_yaml());
         return Ok(());
     }
+    if motion && states.is_none() {
+        bail!("--motion needs --states FILE.jsonl (the waypoints of a path)");
+    }
     let mut pipeline = super::load::pipeline(args)?;
     let s = pipeline.checker().summary();
     eprintln!(

@@ -3,7 +3,7 @@
 Sends the node what an attacker, or a careless colleague, would: joint states that are NaN, a
 million elements long, a 10,000-state burst, or bytes that are not a JointState; then
 robot_descriptions that are deep, huge, point at special files or are not text at all (latched,
-as robot_state_publisher offers them). Then valid states (for the robot the node kept), a good
+as robot_state_publisher offers them); a DATA_FRAG made by hand announcing a 3 GB sample. Then valid states (for the robot the node kept), a good
 description and valid states for it; it returns their reports and the node's /diagnostics along
 the way. Loopback only: the caller sets CYCLONEDDS_URI
 (127.0.0.1, no multicast, peer 127.0.0.1), and runs the peer in the node's network namespace when
@@ -13,6 +13,7 @@ stdin: {"domain": id, "timeout": s,
         "descriptions": [{"label": l, "text": t} | {"label": l, "deep": n} | {"label": l, "bytes": n}, each with
                          "expect": what the last one's refusal says],
         "raw_descriptions": n, "nan_states": n, "raw_states": n, "huge_state": n, "burst": n,
+        "huge_datafrag": announced sample size of a hand-made DATA_FRAG, "node_pid": the node's pid,
         "states_kept": [{"name": [...], "position": [...], "stamp": ns}], "good_description": t, "states_good": [...]}
 stdout: {"matched": bool, "sent": {...}, "largest_message": bytes, "diag_after_descriptions": status,
          "reports_kept": [...], "diag_after_good": status, "reports_good": [...], "diag_final": status, "seconds": {...}}
@@ -191,6 +192,46 @@ for k in range(req.get("raw_descriptions", 0) if "not_acknowledged" not in sent 
 sent["descriptions"] = acked_labels
 sent["raw_descriptions"] = req.get("raw_descriptions", 0)
 out["seconds"]["descriptions"] = time.time() - t0
+
+# A DATA_FRAG made by hand announcing a sample of `huge_datafrag` bytes (about 3 GB), sent over
+# UDP to every port the node's process has open (found from /proc/<node_pid>: its sockets' inodes
+# in /proc/<pid>/fd, their ports in /proc/<pid>/net/udp, the node's network namespace). RTPS header
+# with our description writer's GUID prefix, INFO_TS, then DATA_FRAG from that writer (readerId
+# unknown: the node hands it to every reader matched with the writer, the robot_description one)
+# carrying fragment 1 of 1 KiB. Once more from a writer the node does not know (random GUID).
+huge = int(req.get("huge_datafrag", 0))
+if huge and req.get("node_pid"):
+    import os
+    import socket
+    pid = int(req["node_pid"])
+    inodes = set()
+    for fd in os.listdir(f"/proc/{pid}/fd"):
+        try:
+            link = os.readlink(f"/proc/{pid}/fd/{fd}")
+        except OSError:
+            continue
+        if link.startswith("socket:["):
+            inodes.add(link[8:-1])
+    ports = sorted({int(f[1].split(":")[1], 16) for f in (ln.split() for ln in Path(f"/proc/{pid}/net/udp").read_text().splitlines()[1:])
+                    if f[9] in inodes})
+
+    def datafrag_message(guid16, sn, sample_size, frag_size=1024):
+        now = time.time()
+        header = b"RTPS" + bytes([2, 3, 0x01, 0x10]) + guid16[:12]
+        info_ts = struct.pack("<BBHiI", 0x09, 0x01, 8, int(now), int((now % 1) * 2**32))
+        payload = b"\x00\x01\x00\x00" + b"x" * (frag_size - 4)  # CDR_LE header, then the sample's first bytes
+        body = struct.pack("<HH", 0, 28) + b"\x00\x00\x00\x00" + guid16[12:] + struct.pack("<iIIHHI", 0, sn, 1, 1, frag_size, sample_size) + payload
+        return header + info_ts + struct.pack("<BBH", 0x16, 0x01, len(body)) + body
+
+    udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    for guid in (desc_w.guid.bytes, os.urandom(12) + desc_w.guid.bytes[12:]):
+        for sn in (1_000_000, 1_000_001):
+            msg = datafrag_message(guid, sn, huge)
+            for port in ports:
+                udp.sendto(msg, ("127.0.0.1", port))
+    udp.close()
+    sent["huge_datafrag"] = {"sample_size": huge, "ports": ports, "datagrams": 4 * len(ports)}
+    time.sleep(1.0)
 
 # The node publishes /diagnostics every second from its loop: none in 3 s, it is gone or stuck.
 out["diag_after_descriptions_any"] = next_diagnostics(3)
