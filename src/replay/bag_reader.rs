@@ -300,7 +300,19 @@ impl Pump {
     /// Hands the records to `on` until it returns `Some`; `Ok(None)` at the clean end of the file.
     fn next_record<T>(&mut self, mut on: impl FnMut(u8, &[u8]) -> Result<Option<T>, Fault>) -> Result<Option<T>, Fault> {
         loop {
-            let want = match self.reader.next_event() {
+            // mcap 0.26's LinearReader subtracts a record's length from its chunk's remaining
+            // size unchecked (`linear_reader.rs:745`): a record inside an uncompressed chunk that
+            // claims more bytes than the chunk has panics with overflow checks on (debug builds;
+            // found by `cargo fuzz`, fuzz/regressions/bag_mcap/). Contained, the file ends there
+            // with an error like any other corrupt MCAP.
+            let reader = &mut self.reader;
+            // (The reader moves into the closure, so the event may borrow it past the call.)
+            let event = crate::limits::contain_panic(move || {
+                let reader = reader;
+                reader.next_event()
+            })
+            .map_err(|panic| Fault::Bad(format!("the mcap crate failed on this file ({panic})")))?;
+            let want = match event {
                 None => return Ok(None),
                 Some(Err(e)) => return Err(Fault::Mcap(e)),
                 Some(Ok(LinearReadEvent::ReadRequest(n))) => n,
