@@ -26,6 +26,8 @@ fn run(args: &[&str]) -> Run {
     static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let k = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let (out_path, err_path) = (dir.join(format!("run{k}.out")), dir.join(format!("run{k}.err")));
+    // Reaped below by `wait4`, which also gives its peak memory (`Child::wait` would not).
+    #[allow(clippy::zombie_processes)]
     let child = Command::new("sh")
         .arg("-c")
         .arg("ulimit -v 2097152 && exec timeout -k 2 30 \"$@\"")
@@ -246,7 +248,8 @@ fn special_files_are_never_read_unbounded() {
 #[test]
 fn malformed_collada_is_refused_not_a_panic() {
     touches_table(&check(&mesh_robot("good_dae.urdf", &write("good.dae", dae(|s| s))), &[]));
-    let cases: [(&str, Box<dyn Fn(String) -> String>); 6] = [
+    type Tweak = Box<dyn Fn(String) -> String>;
+    let cases: [(&str, Tweak); 6] = [
         ("index_past", Box::new(|s| s.replace("1 2 3</p>", "1 2 9</p>"))),
         ("stride_zero", Box::new(|s| s.replace("stride=\"3\"", "stride=\"0\""))),
         ("stride_huge", Box::new(|s| s.replace("stride=\"3\"", "stride=\"4000000000\""))),

@@ -230,7 +230,7 @@ fn sat_agrees_with_gjk_across_the_accepted_range() {
     let pool = cell_pool();
     let mut rng = Rand64::new(15);
     let kinds = [Kind::Box, Kind::Hull, Kind::Sphere, Kind::Capsule, Kind::Cylinder];
-    let (mut colliding, mut decided, mut largest, mut worst_point) = (0usize, 0usize, 0.0 as Real, 0.0 as Real);
+    let (mut colliding, mut decided, mut largest, mut worst_point) = (0usize, 0usize, 0.0_f64, 0.0_f64);
     for pair in 0..EXTREME_PAIRS {
         let kind = kinds[pair % kinds.len()];
         let (cell, side) = &pool[(rng.rand_u64() % pool.len() as u64) as usize];
@@ -239,9 +239,9 @@ fn sat_agrees_with_gjk_across_the_accepted_range() {
         let cell_size = verts.iter().map(|v| v.distance(centre)).fold(0.0, Real::max);
         // Sizes log-uniform from 1 mm; `random_shape` draws dimensions up to 1x `size`, so the
         // largest dimension stays within 1e4 m.
-        let size = (10.0 as Real).powf(rf(&mut rng, -3.0, 4.0));
+        let size = Real::powf(10.0, rf(&mut rng, -3.0, 4.0));
         let (shape, parry_shape, shape_in_target) = random_shape(&mut rng, kind, size);
-        let far = (10.0 as Real).powf(rf(&mut rng, 0.0, 5.0));
+        let far = Real::powf(10.0, rf(&mut rng, 0.0, 5.0));
         let object_pose = Pose::from_parts(unit(&mut rng) * far, rotation(&mut rng));
         let offset = unit(&mut rng) * (cell_size + size) * rf(&mut rng, 0.0, 1.0);
         let target_pose = Pose::from_parts(object_pose * (centre + offset), rotation(&mut rng));
