@@ -36,11 +36,11 @@ fi
 echo "fuzz_campaign: building the targets"
 cargo +nightly fuzz build -s none
 
-# 2. Seeds: generated from the bundled workcell by the library (tests/fuzz_regressions.rs), the
+# 2. Seeds: generated from the bundled workcell by the library (examples/fuzz_seeds.rs), the
 #    saved inputs of fuzz/regressions/<target>/ (passed as a second corpus directory), and the
 #    small URDF, STL and COLLADA files of example-robot-data when the test venv has it.
 echo "fuzz_campaign: writing the seed corpus"
-FUZZ_CORPUS_DIR="$ROOT/fuzz/corpus" cargo test --quiet --test fuzz_regressions -- --ignored --exact write_seed_corpus >/dev/null
+cargo run --quiet --example fuzz_seeds -- "$ROOT/fuzz/corpus" >/dev/null
 VENV=${TC_VENV:-$HOME/.cache/thickness_collision/venv}
 if [ -d "$VENV" ]; then
     for ext in urdf:urdf stl:mesh_stl dae:mesh_dae obj:mesh_obj; do

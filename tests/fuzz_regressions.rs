@@ -2,7 +2,7 @@
 //! few small seeds) through the same entry function its `cargo fuzz` target calls
 //! (`thickness_collision::fuzz_entry`), on stable: none may panic. See docs/fuzzing.md.
 //!
-//! `write_seed_corpus` (ignored) writes the generated seed corpus for `scripts/fuzz_campaign.sh`.
+//! `examples/fuzz_seeds.rs` writes the generated seed corpus for `scripts/fuzz_campaign.sh`.
 
 use std::path::{Path, PathBuf};
 use thickness_collision::fuzz_entry::{seeds, TARGETS};
@@ -60,18 +60,6 @@ fn generated_seeds_run_without_panic() {
         assert!(!bytes.is_empty(), "seed {target}/{name} is empty");
         let entry = TARGETS.iter().find(|(t, _)| t == target).map(|(_, e)| *e).expect("a known target");
         entry(bytes);
-    }
-}
-
-/// Writes the generated seeds to `$FUZZ_CORPUS_DIR/<target>/` (default `fuzz/corpus/`).
-#[test]
-#[ignore = "writes the fuzz seed corpus; run by scripts/fuzz_campaign.sh"]
-fn write_seed_corpus() {
-    let root = std::env::var_os("FUZZ_CORPUS_DIR").map(PathBuf::from).unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz").join("corpus"));
-    for (target, name, bytes) in seeds() {
-        let dir = root.join(target);
-        std::fs::create_dir_all(&dir).expect("corpus directory");
-        std::fs::write(dir.join(format!("seed_{name}")), bytes).expect("seed written");
     }
 }
 
