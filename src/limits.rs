@@ -29,6 +29,8 @@ pub const LENGTH_RANGE: [f64; 2] = [1e-6, 1e4];
 pub const MAX_COORDINATE: f64 = 1e5;
 /// Longest list of names quoted in one error line; the rest are counted.
 pub const MAX_NAMES_IN_ERROR: usize = 8;
+/// Entries one `JointState` field may hold (`msgs::MAX_JOINT_STATE_ENTRIES`, refused while decoding).
+pub use crate::msgs::MAX_JOINT_STATE_ENTRIES;
 
 /// A file that cannot be read within the bounds.
 #[derive(Debug, thiserror::Error)]

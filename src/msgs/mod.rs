@@ -10,7 +10,37 @@ mod definitions;
 
 pub use self::definitions::{full_definition, COLLISION_REPORT_TYPE};
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
+
+/// Entries a `JointState` field may hold when decoded (a robot has hundreds of joints at most).
+/// A longer sequence is refused while it is read, before its elements are allocated: a
+/// million made-up names would otherwise cost some 60 MB of strings per message.
+pub const MAX_JOINT_STATE_ENTRIES: usize = 65_536;
+
+/// A sequence of at most [`MAX_JOINT_STATE_ENTRIES`], refused as soon as it runs past.
+fn bounded_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
+    struct Bounded<T>(std::marker::PhantomData<T>);
+    impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Bounded<T> {
+        type Value = Vec<T>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(f, "a sequence of at most {MAX_JOINT_STATE_ENTRIES} entries")
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<T>, A::Error> {
+            if let Some(n) = seq.size_hint().filter(|n| *n > MAX_JOINT_STATE_ENTRIES) {
+                return Err(serde::de::Error::custom(format!("a joint state field of {n} entries; at most {MAX_JOINT_STATE_ENTRIES} allowed")));
+            }
+            let mut out = Vec::with_capacity(seq.size_hint().unwrap_or(0).min(1024));
+            while let Some(x) = seq.next_element()? {
+                if out.len() == MAX_JOINT_STATE_ENTRIES {
+                    return Err(serde::de::Error::custom(format!("a joint state field of more than {MAX_JOINT_STATE_ENTRIES} entries; at most {MAX_JOINT_STATE_ENTRIES} allowed")));
+                }
+                out.push(x);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_seq(Bounded(std::marker::PhantomData))
+}
 
 /// `builtin_interfaces/msg/Time`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
@@ -55,12 +85,16 @@ pub struct JointState {
     /// Header.
     pub header: Header,
     /// Joint names.
+    #[serde(deserialize_with = "bounded_seq")]
     pub name: Vec<String>,
     /// Positions (radians or metres).
+    #[serde(deserialize_with = "bounded_seq")]
     pub position: Vec<f64>,
     /// Velocities.
+    #[serde(deserialize_with = "bounded_seq")]
     pub velocity: Vec<f64>,
     /// Efforts.
+    #[serde(deserialize_with = "bounded_seq")]
     pub effort: Vec<f64>,
 }
 
@@ -302,4 +336,92 @@ pub struct DiagnosticArray {
     pub header: Header,
     /// Statuses.
     pub status: Vec<DiagnosticStatus>,
+}
+
+/// Points, joint names, and entries of one point's fields a `trajectory_msgs/JointTrajectory`
+/// may hold when decoded. A longer sequence is refused while it is read, before its elements are
+/// allocated (an empty point costs 24 bytes on the wire and some 100 in memory).
+pub const MAX_TRAJECTORY_ENTRIES: usize = 65_536;
+
+/// A trajectory sequence of at most [`MAX_TRAJECTORY_ENTRIES`], refused as soon as it runs past.
+fn bounded_trajectory_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
+    struct Bounded<T>(std::marker::PhantomData<T>);
+    impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Bounded<T> {
+        type Value = Vec<T>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(f, "a sequence of at most {MAX_TRAJECTORY_ENTRIES} entries")
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<T>, A::Error> {
+            let too_long = |n: &str| serde::de::Error::custom(format!("a trajectory field of {n} entries; at most {MAX_TRAJECTORY_ENTRIES} allowed"));
+            if let Some(n) = seq.size_hint().filter(|n| *n > MAX_TRAJECTORY_ENTRIES) {
+                return Err(too_long(&n.to_string()));
+            }
+            let mut out = Vec::with_capacity(seq.size_hint().unwrap_or(0).min(1024));
+            while let Some(x) = seq.next_element()? {
+                if out.len() == MAX_TRAJECTORY_ENTRIES {
+                    return Err(too_long(&format!("more than {MAX_TRAJECTORY_ENTRIES}")));
+                }
+                out.push(x);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_seq(Bounded(std::marker::PhantomData))
+}
+
+/// `trajectory_msgs/msg/JointTrajectoryPoint`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct JointTrajectoryPoint {
+    /// Positions, one per joint name (radians or metres).
+    #[serde(deserialize_with = "bounded_trajectory_seq")]
+    pub positions: Vec<f64>,
+    /// Velocities (not used by the check).
+    #[serde(deserialize_with = "bounded_trajectory_seq")]
+    pub velocities: Vec<f64>,
+    /// Accelerations (not used by the check).
+    #[serde(deserialize_with = "bounded_trajectory_seq")]
+    pub accelerations: Vec<f64>,
+    /// Efforts (not used by the check).
+    #[serde(deserialize_with = "bounded_trajectory_seq")]
+    pub effort: Vec<f64>,
+    /// When the point is reached, from the trajectory's start.
+    pub time_from_start: DurationMsg,
+}
+
+/// `trajectory_msgs/msg/JointTrajectory`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct JointTrajectory {
+    /// Header.
+    pub header: Header,
+    /// The joints every point gives a position for, in order.
+    #[serde(deserialize_with = "bounded_trajectory_seq")]
+    pub joint_names: Vec<String>,
+    /// Waypoints.
+    #[serde(deserialize_with = "bounded_trajectory_seq")]
+    pub points: Vec<JointTrajectoryPoint>,
+}
+
+/// `thickness_collision_msgs/srv/CheckTrajectory` request.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CheckTrajectoryRequest {
+    /// The trajectory; joints it does not name keep the node's current merged state.
+    pub trajectory: JointTrajectory,
+}
+
+/// `thickness_collision_msgs/srv/CheckTrajectory` response.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CheckTrajectoryResponse {
+    /// Every segment (linear interpolation between waypoints) is free.
+    pub valid: bool,
+    /// The first segment (from point `segment` to point `segment + 1`) found colliding or not
+    /// checkable; -1 when valid or when the request itself is refused.
+    pub segment: i32,
+    /// The first contact along `segment`, in [0, 1]; -1 when there is none.
+    pub fraction: f64,
+    /// `t_i + fraction · (t_{i+1} - t_i)` for `segment` i; zero when there is no contact.
+    pub time_from_start: DurationMsg,
+    /// The contacts of the pose at `fraction`.
+    pub contacts: Vec<ContactMsg>,
+    /// Why the trajectory was refused or could not be checked; empty otherwise.
+    pub error: String,
 }

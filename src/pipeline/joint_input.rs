@@ -4,6 +4,9 @@
 use crate::checker::StateError;
 use crate::model::{MissingJoint, RobotModel};
 
+/// Unknown names passed back from one message at most.
+const MAX_UNKNOWN_REPORTED: usize = 64;
+
 /// The positions received so far (merged across messages under `last` and `reject`).
 #[derive(Clone, Debug)]
 pub(crate) struct JointInput {
@@ -36,7 +39,10 @@ impl JointInput {
                 Some(_) if !value.is_finite() => return Err(StateError::NonFinite { joint: name.clone(), value }),
                 Some(j) if given.iter().any(|(k, _)| *k == j) => return Err(StateError::Duplicate(name.clone())),
                 Some(j) => given.push((j, value)),
-                None => unknown.push(name.clone()),
+                // The pipeline warns about a bounded number of names; a message of made-up
+                // names must not cost a copy of each.
+                None if unknown.len() < MAX_UNKNOWN_REPORTED => unknown.push(name.clone()),
+                None => {}
             }
         }
         if missing == MissingJoint::Zero {
@@ -55,5 +61,11 @@ impl JointInput {
                 None => Ok(0.0),
             })
             .collect()
+    }
+
+    /// The positions received so far, by joint index (`None`: never received, or cleared under
+    /// `missing_joint: zero`).
+    pub fn current(&self) -> &[Option<f64>] {
+        &self.received
     }
 }

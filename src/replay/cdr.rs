@@ -47,3 +47,18 @@ pub fn encode_cdr_le<T: Serialize>(msg: &T) -> Vec<u8> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::msgs::{JointState, MAX_JOINT_STATE_ENTRIES};
+
+    #[test]
+    fn a_joint_state_past_the_entry_bound_is_refused_while_decoding() {
+        let at = |n: usize| JointState { name: vec!["j".into(); n], position: vec![0.5; n], ..Default::default() };
+        let ok: JointState = decode_cdr(&encode_cdr_le(&at(MAX_JOINT_STATE_ENTRIES))).unwrap();
+        assert_eq!(ok.name.len(), MAX_JOINT_STATE_ENTRIES);
+        let e = decode_cdr::<JointState>(&encode_cdr_le(&at(MAX_JOINT_STATE_ENTRIES + 1))).unwrap_err().to_string();
+        assert!(e.contains("65537 entries; at most 65536 allowed") || e.contains("more than 65536 entries"), "{e}");
+    }
+}

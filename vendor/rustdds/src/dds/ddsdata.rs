@@ -60,6 +60,16 @@ impl DDSData {
     }
   }
 
+  // thickness_collision patch: drop the payload bytes of a change every reader
+  // has taken (see `TopicCache::note_taken`); the header stays.
+  pub(crate) fn release_payload(&mut self) {
+    match self {
+      DDSData::Data { serialized_payload } => serialized_payload.value = Bytes::new(),
+      DDSData::DisposeByKey { key, .. } => key.value = Bytes::new(),
+      DDSData::DisposeByKeyHash { .. } => {}
+    }
+  }
+
   pub(crate) fn reallocate(&mut self) {
     match self {
       DDSData::Data { serialized_payload } => serialized_payload.reallocate(),

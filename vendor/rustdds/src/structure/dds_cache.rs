@@ -25,6 +25,11 @@ use crate::{
 };
 use super::cache_change::CacheChange;
 
+// thickness_collision patch: a payload longer than one UDP datagram was
+// reassembled from fragments into a buffer of its own (see
+// `SerializedPayload::reallocate`).
+const LARGE_PAYLOAD_BYTES: usize = 64 * 1024;
+
 /// DDSCache contains all cacheChanges that are
 /// received by this participant. It is for serving local Readers. Local
 /// Writers each contain a HistoryBuffer to CacheChanges written by themselves.
@@ -121,6 +126,10 @@ pub(crate) struct TopicCache {
   topic_qos: QosPolicies,
   min_keep_samples: History,
   max_keep_samples: i32, // from QoS, for quick, repeated access
+  // thickness_collision patch: large payloads are released once every local
+  // reader has taken them (see `note_taken`).
+  local_readers: usize,
+  taken_large: BTreeMap<Timestamp, usize>,
   // TODO: Change this to Option<u32>, where None means "no limit".
 
   // The main content of the cache is in this map.
@@ -165,6 +174,8 @@ impl TopicCache {
       min_keep_samples: History::KeepLast { depth: 1 }, /* dummy value, next call will overwrite
                                                          * this */
       max_keep_samples: 1, // dummy value, next call will overwrite this
+      local_readers: 0,
+      taken_large: BTreeMap::new(),
       changes: BTreeMap::new(),
       changes_reallocated_up_to: Timestamp::ZERO,
       last_added_instant: Timestamp::ZERO,
@@ -294,6 +305,35 @@ impl TopicCache {
       gave_up = true;
     }
     gave_up
+  }
+
+  // thickness_collision patch: a reassembled sample (larger than one datagram) was
+  // held here until `max_keep_samples` newer ones pushed it out (64 by default),
+  // long after the reader had taken and deserialized it: a 50 MB
+  // `robot_description` stayed resident twice for the whole run. Its bytes are
+  // released once every local reader of the topic has taken it; the change
+  // itself stays, so sequence-number bookkeeping is untouched.
+  pub(crate) fn add_local_reader(&mut self) {
+    self.local_readers += 1;
+  }
+
+  pub(crate) fn remove_local_reader(&mut self) {
+    self.local_readers = self.local_readers.saturating_sub(1);
+  }
+
+  pub(crate) fn note_taken(&mut self, instant: Timestamp) {
+    let Some(cc) = self.changes.get_mut(&instant) else {
+      return;
+    };
+    if cc.data_value.payload_size() <= LARGE_PAYLOAD_BYTES {
+      return;
+    }
+    let taken = self.taken_large.entry(instant).or_insert(0);
+    *taken += 1;
+    if *taken >= self.local_readers {
+      self.taken_large.remove(&instant);
+      cc.data_value.release_payload();
+    }
   }
 
   pub fn get_change(&self, instant: &Timestamp) -> Option<&CacheChange> {
@@ -548,6 +588,12 @@ impl TopicCache {
 
       // update also SequenceNumber map
       to_remove.values().for_each(|r| self.remove_sn(r));
+      // thickness_collision patch: forget take counts of evicted changes.
+      if let Some(first) = self.changes.keys().next().copied() {
+        self.taken_large = self.taken_large.split_off(&first);
+      } else {
+        self.taken_large.clear();
+      }
     }
 
     // Now, reallocate old cache changes

@@ -120,6 +120,10 @@ where
   DA: DeserializerAdapter<D>,
 {
   fn drop(&mut self) {
+    // thickness_collision patch: see `SimpleDataReader::new`.
+    if let Ok(mut cache) = self.topic_cache.lock() {
+      cache.remove_local_reader();
+    }
     // Tell dp_event_loop
     self.my_subscriber.remove_reader(self.my_guid);
 
@@ -168,8 +172,16 @@ where
     let my_guid = GUID::new_with_prefix_and_id(dp.guid_prefix(), my_id);
 
     // Verify that the topic cache corresponds to the topic of the Reader
-    let topic_cache_name = topic_cache.lock().unwrap().topic_name();
+    let topic_cache_name = {
+      let mut cache = topic_cache.lock().unwrap();
+      // thickness_collision patch: counted so the cache knows when every local
+      // reader has taken a large sample (`TopicCache::note_taken`).
+      cache.add_local_reader();
+      cache.topic_name()
+    };
     if topic.name() != topic_cache_name {
+      // thickness_collision patch: this reader will not exist.
+      topic_cache.lock().unwrap().remove_local_reader();
       return Err(CreateError::Internal {
         reason: format!(
           "Topic name = {} and topic cache name = {} not equal when creating a SimpleDataReader",
@@ -348,7 +360,7 @@ where
       Some(policy::Reliability::Reliable { .. })
     );
 
-    let topic_cache = self.acquire_the_topic_cache_guard();
+    let mut topic_cache = self.acquire_the_topic_cache_guard();
 
     let mut read_state_ref = self.read_state.lock().unwrap();
     let latest_instant = read_state_ref.latest_instant;
@@ -382,6 +394,9 @@ where
         read_state_ref
           .last_read_sn
           .insert(writer_guid, sequence_number);
+        // thickness_collision patch: the deserialized sample owns its data; the
+        // cache may release a large payload now (`TopicCache::note_taken`).
+        topic_cache.note_taken(timestamp);
 
         // // Debug sanity check:
         // use crate::Duration;
