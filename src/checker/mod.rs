@@ -6,7 +6,9 @@
 mod checker_build;
 mod joint_state;
 mod motion;
+mod motion_sweep;
 mod state_report;
+mod world_motion;
 
 pub use self::checker_build::{BuildSummary, Checker, CheckerError, LinkTargets};
 pub use self::joint_state::StateError;

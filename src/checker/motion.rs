@@ -2,18 +2,24 @@
 //! missed (adaptive conservative checking, after Schwarzer, Saha and Latombe, IEEE T-RO 21(3),
 //! 2005).
 //!
-//! Over a sub-interval `[a, b]` of the motion parameter, every point of link `k` stays within
-//! `δ_k = (b - a)/2 · Σ_j |Δq_j| · r_jk` of where it is at the middle (`r_jk` bounds the distance
-//! from joint `j`'s axis to any point of the link in every configuration; 1 for a prismatic
-//! joint). The link at the middle, grown by `δ_k`, contains every pose of the link on `[a, b]`:
-//! if the grown link touches nothing, the sub-interval is free for that link. Otherwise the
-//! sub-interval is halved, left half first, until the growth falls under `motion_tolerance`:
-//! that sub-interval is reported colliding. So "free" is certain, and a reported fraction is
-//! never later than the first contact.
+//! Over a sub-interval `[a, b]` of the motion parameter, with `h = (b - a)/2`, every point of
+//! link `k` stays within `δ_k = h · Σ_j |Δq_j| · r_jk` of where it is at the middle (`r_jk`
+//! bounds the distance from joint `j`'s axis to any point of the link in every configuration; 1
+//! for a prismatic joint). Each `r_jk` is tightened with the configuration at the middle: the
+//! distance from `j`'s axis to `k`'s origin there plus `k`'s reach, plus what the joints between
+//! `j` and `k` can change it by within `h` (see `JointPath::bound`). The link at the middle, grown
+//! by `δ_k`, contains every pose of the link on `[a, b]`: if the grown link touches nothing, the
+//! sub-interval is free for that link. Otherwise the sub-interval is halved, left half first,
+//! until the growth falls under `motion_tolerance`: that sub-interval is reported colliding. So
+//! "free" is certain, and a reported fraction is never later than the first contact.
+//!
+//! The loop itself (`motion_sweep`) is shared with motions between link poses
+//! (`world_motion`, for `/tf` input).
 
 use super::checker_build::{Checker, LinkTargets};
-use super::state_report::{ReportContact, StateReport};
-use crate::collision::{CollideSettings, ConvexHull, Target, TargetShape};
+use super::motion_sweep::MotionPath;
+use super::state_report::StateReport;
+use crate::collision::{ConvexHull, TargetShape};
 use crate::math::{pose_from_isometry, Pose, Real, Vector};
 use crate::model::{JointKind, RobotModel};
 use std::sync::{Arc, OnceLock};
@@ -21,9 +27,13 @@ use std::sync::{Arc, OnceLock};
 /// Sub-intervals examined at most per motion; past that the motion fails closed.
 pub const MAX_SUBINTERVALS: u64 = 1 << 20;
 
-/// Levels of the growth ladder: `base · 2^level` for level 0..LEVELS covers 1e-6 m to far past
-/// any accepted size.
-const LEVELS: usize = 64;
+/// Rungs of the growth ladder per doubling: growth `base · 2^(level / RUNGS)`. The growth used is
+/// the first rung at or above the bound, so it overshoots by up to `2^(1/RUNGS)`; a grown link
+/// that overshoots touches more and splits more often.
+const RUNGS: usize = 2;
+
+/// Levels of the growth ladder: from `base` (half the tolerance) to far past any accepted size.
+const LEVELS: usize = 64 * RUNGS;
 
 /// What a motion check gives.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -43,11 +53,12 @@ pub struct MotionReport {
 pub(crate) struct MotionBounds {
     /// Per target (as `Checker::targets`): (joint index, lever in metres; 1 for prismatic).
     levers: Vec<Vec<(usize, Real)>>,
+    /// Per target: the farthest any of its points lies from its link's origin.
+    pub(super) reach: Vec<Real>,
     /// Per target, per part, per level: the part grown by `base · 2^level`.
-    grown: Vec<Vec<Vec<OnceLock<TargetShape>>>>,
+    pub(super) grown: Vec<Vec<Vec<OnceLock<TargetShape>>>>,
     /// Growth of level 0: half the tolerance, so a level under the tolerance exists.
     base: Real,
-    tolerance: Real,
 }
 
 /// Farthest any point of a part lies from its link's origin.
@@ -63,7 +74,7 @@ fn part_reach(shape: &TargetShape, offset: &Pose) -> Real {
 
 /// A superset of `shape ⊕ ball(pad)`: for a hull its Minkowski sum with a cube of half-side `pad`
 /// (which contains the ball); primitives grown in closed form.
-fn grow(shape: &TargetShape, pad: Real) -> TargetShape {
+pub(super) fn grow(shape: &TargetShape, pad: Real) -> TargetShape {
     match shape {
         TargetShape::Sphere { radius } => TargetShape::Sphere { radius: radius + pad },
         TargetShape::Capsule { half_height, radius } => TargetShape::Capsule { half_height: *half_height, radius: radius + pad },
@@ -90,8 +101,10 @@ impl MotionBounds {
             parent_joint[joint.child] = Some(j);
         }
         let mut levers = Vec::with_capacity(targets.len());
+        let mut reaches = Vec::with_capacity(targets.len());
         for t in targets {
             let reach = t.parts.iter().map(|(s, o)| part_reach(s, o)).fold(0.0, Real::max);
+            reaches.push(reach);
             // Walk up from the link: `chain` is the farthest the link's origin can be from the
             // origin of the joint reached so far, in any configuration.
             let mut chain = 0.0;
@@ -118,19 +131,82 @@ impl MotionBounds {
             levers.push(list);
         }
         let grown = targets.iter().map(|t| t.parts.iter().map(|_| (0..LEVELS).map(|_| OnceLock::new()).collect()).collect()).collect();
-        MotionBounds { levers, grown, base: tolerance / 2.0, tolerance }
+        MotionBounds { levers, reach: reaches, grown, base: tolerance / 2.0 }
     }
 
     /// The ladder level whose growth covers `delta`.
-    fn level(&self, delta: Real) -> usize {
+    pub(super) fn level(&self, delta: Real) -> usize {
         if delta <= self.base {
             return 0;
         }
-        ((delta / self.base).log2().ceil() as usize).min(LEVELS - 1)
+        // Rounding can leave `growth(level)` a hair under `delta`: the caller checks, and
+        // splits when it is (as it does past the top of the ladder).
+        (((delta / self.base).log2() * RUNGS as Real).ceil() as usize).min(LEVELS - 1)
     }
 
-    fn growth(&self, level: usize) -> Real {
-        self.base * Real::powi(2.0, level as i32)
+    /// The growth of ladder `level` (metres).
+    pub(super) fn growth(&self, level: usize) -> Real {
+        self.base * Real::exp2(level as Real / RUNGS as Real)
+    }
+}
+
+/// A motion in joint space: `q0 + s·delta`, link poses by forward kinematics.
+struct JointPath<'a> {
+    checker: &'a Checker,
+    q0: &'a [f64],
+    delta: Vec<f64>,
+    speeds: Vec<Real>,
+}
+
+impl JointPath<'_> {
+    fn at(&self, s: f64) -> Vec<f64> {
+        self.q0.iter().zip(&self.delta).map(|(a, d)| a + s * d).collect()
+    }
+}
+
+impl MotionPath for JointPath<'_> {
+    fn speeds(&self) -> &[Real] {
+        &self.speeds
+    }
+
+    fn link_poses(&self, s: f64) -> Result<Vec<Option<Pose>>, String> {
+        let poses = self.checker.robot().forward_kinematics(&self.at(s), self.checker.base_pose()).map_err(|e| e.to_string())?;
+        Ok(poses.iter().map(|p| Some(pose_from_isometry(p))).collect())
+    }
+
+    /// Tighter than `half · speed` where the link is nearer a joint's axis than the lever bound
+    /// allows for: the distance from joint `j`'s axis to a point of link `k` at `s` is at most
+    /// the distance from the axis to `k`'s origin there plus `k`'s reach, and within `half` of
+    /// `s` it grows by at most what the joints between `j` and `k` move the point relative to
+    /// `j`, `half · Σ_i |Δq_i| r_ik`. Each joint's lever is the smaller of that and `r_jk`.
+    fn bound(&self, ti: usize, poses: &[Option<Pose>], half: f64) -> Real {
+        let robot = self.checker.robot();
+        let bounds = self.checker.motion_bounds();
+        let Some(link) = poses[self.checker.targets()[ti].link] else { return half * self.speeds[ti] };
+        let reach = bounds.reach[ti];
+        // Σ_i |Δq_i| r_ik over the joints between the current one and the link.
+        let mut below = 0.0;
+        let mut total = 0.0;
+        for &(j, r) in &bounds.levers[ti] {
+            let d = self.delta[j].abs();
+            let joint = &robot.joints[j];
+            let lever = match (joint.kind, poses[joint.child]) {
+                (JointKind::Revolute | JointKind::Continuous, Some(child)) => {
+                    let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
+                    let rel = link.translation - child.translation;
+                    let off_axis = (rel - axis * rel.dot(axis)).length();
+                    r.min(off_axis + reach + half * below)
+                }
+                _ => r,
+            };
+            total += d * lever;
+            below += d * r;
+        }
+        half * total
+    }
+
+    fn report_at(&self, s: f64) -> StateReport {
+        self.checker.check_positions(&self.at(s)).unwrap_or_else(|e| StateReport::failed(e.to_string()))
     }
 }
 
@@ -168,98 +244,10 @@ impl Checker {
                 delta[i] = m.multiplier * delta[m.joint];
             }
         }
-        let at = |s: f64| -> Vec<f64> { q0.iter().zip(&delta).map(|(a, d)| a + s * d).collect() };
         let bounds = self.motion_bounds();
         // Per target: Σ_j |Δq_j| r_jk, the speed bound of its points per unit of s.
-        let speed: Vec<Real> = bounds.levers.iter().map(|l| l.iter().map(|(j, r)| delta[*j].abs() * r).sum()).collect();
-        let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
-
-        let mut stack: Vec<(f64, f64, Vec<usize>)> = vec![(0.0, 1.0, (0..self.targets().len()).collect())];
-        let mut examined = 0u64;
-        while let Some((a, b, links)) = stack.pop() {
-            examined += 1;
-            if examined > MAX_SUBINTERVALS {
-                let mut report = StateReport::failed(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"));
-                report.motion = true;
-                return MotionReport { report, fraction: None, subintervals: examined };
-            }
-            let m = 0.5 * (a + b);
-            let poses = match robot.forward_kinematics(&at(m), self.base_pose()) {
-                Ok(p) => p,
-                Err(e) => return MotionReport { report: StateReport::failed(e.to_string()), fraction: None, subintervals: examined },
-            };
-            let mut split = Vec::new();
-            for &ti in &links {
-                let lt = &self.targets()[ti];
-                // A link no joint moves is where it is at every s: checked as it is, ungrown (a
-                // base resting on a table is not a near miss).
-                let level = (speed[ti] > 0.0).then(|| bounds.level(0.5 * (b - a) * speed[ti]));
-                let link_pose = pose_from_isometry(&poses[lt.link]);
-                let hit = self.grown_link_hit(ti, level, &link_pose, &flags);
-                if !hit {
-                    continue;
-                }
-                if level.is_none_or(|l| bounds.growth(l) < bounds.tolerance) {
-                    return self.motion_contact(&at(a), ti, level, &link_pose, a, examined);
-                }
-                split.push(ti);
-            }
-            if !split.is_empty() {
-                stack.push((m, b, split.clone()));
-                stack.push((a, m, split));
-            }
-        }
-        MotionReport { report: StateReport { motion: true, ..Default::default() }, fraction: None, subintervals: examined }
-    }
-
-    /// Target `ti`'s part `pi` grown by ladder `level` (as it is for `None`).
-    fn grown_part(&self, ti: usize, pi: usize, level: Option<usize>) -> &TargetShape {
-        let (shape, _) = &self.targets()[ti].parts[pi];
-        match level {
-            None => shape,
-            Some(level) => {
-                let bounds = self.motion_bounds();
-                bounds.grown[ti][pi][level].get_or_init(|| grow(shape, bounds.growth(level)))
-            }
-        }
-    }
-
-    /// Whether target `ti`, every part grown by ladder `level`, touches anything it may not.
-    fn grown_link_hit(&self, ti: usize, level: Option<usize>, link_pose: &Pose, settings: &CollideSettings) -> bool {
-        self.targets()[ti].parts.iter().enumerate().any(|(pi, (_, offset))| {
-            let target = Target::new(self.grown_part(ti, pi, level).clone(), *link_pose * *offset);
-            !self.collide_target(ti, &target, settings).contacts.is_empty()
-        })
-    }
-
-    /// The report of a motion found colliding on the sub-interval starting at `fraction`: the
-    /// contacts of the pose there, or for a near miss the object the grown link touched, depth 0.
-    fn motion_contact(&self, q: &[f64], ti: usize, level: Option<usize>, mid_pose: &Pose, fraction: f64, examined: u64) -> MotionReport {
-        let mut report = match self.check_positions(q) {
-            Ok(r) => r,
-            Err(e) => StateReport::failed(e.to_string()),
-        };
-        if !report.contacts.iter().any(|c| c.link_name == self.targets()[ti].name) {
-            let settings = CollideSettings { flag_only: false, least_overlap: false, ..Default::default() };
-            let lt = &self.targets()[ti];
-            let near = lt.parts.iter().enumerate().find_map(|(pi, (_, offset))| {
-                self.collide_target(ti, &Target::new(self.grown_part(ti, pi, level).clone(), *mid_pose * *offset), &settings).deepest().copied()
-            });
-            if let Some(c) = near {
-                report.contacts.push(ReportContact {
-                    link_name: lt.name.clone(),
-                    object_name: self.scene().objects()[c.object].name.clone(),
-                    triangle: c.triangle,
-                    depth: 0.0,
-                    position: c.position.map(|p| p.to_array()),
-                    normal: c.normal.to_array(),
-                });
-            }
-        }
-        report.in_collision = true;
-        report.motion = true;
-        report.fraction = Some(fraction);
-        MotionReport { report, fraction: Some(fraction), subintervals: examined }
+        let speeds = bounds.levers.iter().map(|l| l.iter().map(|(j, r)| delta[*j].abs() * r).sum()).collect();
+        self.sweep_motion(&JointPath { checker: self, q0, delta, speeds })
     }
 }
 

@@ -1,5 +1,9 @@
 //! The node's life: participant, node, topics and services, and the loop that hands every
 //! input to the [`Pipeline`] and publishes what it returns. Nothing here decides an answer.
+//!
+//! `check_trajectory` requests are resolved by the pipeline on the loop (validation and the
+//! current joint state: no geometry) and checked on a worker thread of their own, so a long
+//! trajectory never stalls the live stream; the loop sends the answer when the worker is done.
 
 use super::markers::{cell_markers, contact_markers, diagnostics, NodeStats};
 use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
@@ -7,8 +11,8 @@ use super::param_values::{declarations, to_json, READ_ONLY};
 use super::ros_args::RosArgs;
 use crate::limits::MAX_DESCRIPTION_BYTES;
 use crate::model::{Params, PoseSource, ServiceMapping};
-use crate::msgs::{CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
-use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause};
+use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
+use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause, TrajectoryJob};
 use anyhow::{anyhow, Context as _, Result};
 use futures::stream::FusedStream;
 use futures::{FutureExt, StreamExt};
@@ -114,6 +118,7 @@ struct Interfaces {
     contacts: ros2_client::Publisher<MarkerArray>,
     diagnostics: ros2_client::Publisher<DiagnosticArray>,
     check_states: ros2_client::Server<CheckStatesRequest, CheckStatesResponse>,
+    check_trajectory: ros2_client::Server<CheckTrajectoryRequest, CheckTrajectoryResponse>,
     names: Names,
 }
 
@@ -122,6 +127,7 @@ struct Names {
     joint_states: String,
     collisions: String,
     check_states: String,
+    check_trajectory: String,
     description: String,
     cells: String,
     contacts: String,
@@ -143,6 +149,7 @@ impl Interfaces {
             joint_states: resolve(remaps, "joint_states"),
             collisions: resolve(remaps, "collisions"),
             check_states: resolve(remaps, "check_states"),
+            check_trajectory: resolve(remaps, "check_trajectory"),
             description: resolve(remaps, "robot_description"),
             cells: resolve(remaps, "collision_markers/cells"),
             contacts: resolve(remaps, "collision_markers/contacts"),
@@ -206,7 +213,16 @@ impl Interfaces {
                 reliable(100),
             )
             .map_err(|e| anyhow!("service {}: {e:?}", names.check_states))?;
-        Ok(Interfaces { states, tf, descriptions, clock, collisions, cells, contacts, diagnostics, check_states, names })
+        let check_trajectory = node
+            .create_server::<CheckTrajectoryRequest, CheckTrajectoryResponse>(
+                mapping,
+                &ros_name(&names.check_trajectory, &namespace)?,
+                &ServiceTypeName::new("thickness_collision_msgs", "CheckTrajectory"),
+                reliable(100),
+                reliable(100),
+            )
+            .map_err(|e| anyhow!("service {}: {e:?}", names.check_trajectory))?;
+        Ok(Interfaces { states, tf, descriptions, clock, collisions, cells, contacts, diagnostics, check_states, check_trajectory, names })
     }
 }
 
@@ -242,9 +258,48 @@ enum Event {
     Description(DescriptionMsg),
     Clock(Time),
     Request(ros2_client::service::RmwRequestId, CheckStatesRequest),
+    TrajectoryRequest(ros2_client::service::RmwRequestId, CheckTrajectoryRequest),
+    /// The worker checked a trajectory: the answer to send.
+    TrajectoryDone(ros2_client::service::RmwRequestId, CheckTrajectoryResponse),
     /// A sample that could not be read (on the topic or service named).
     ReadFailed(&'static str, ReadError),
     Tick,
+}
+
+/// `check_trajectory` requests waiting for or in the worker at most; one past that is answered at
+/// once (`valid` false, "busy"), so a flood of requests cannot queue without bound.
+const MAX_TRAJECTORIES_PENDING: usize = 8;
+
+/// The worker that checks trajectories off the loop, one at a time, in arrival order.
+struct TrajectoryWorker {
+    jobs: std::sync::mpsc::SyncSender<(ros2_client::service::RmwRequestId, TrajectoryJob)>,
+    done: smol::channel::Receiver<(ros2_client::service::RmwRequestId, CheckTrajectoryResponse)>,
+}
+
+impl TrajectoryWorker {
+    /// Starts the thread; it ends when the loop drops the worker (a job in progress runs out).
+    fn start() -> Result<TrajectoryWorker> {
+        let (jobs, queue) = std::sync::mpsc::sync_channel::<(ros2_client::service::RmwRequestId, TrajectoryJob)>(MAX_TRAJECTORIES_PENDING);
+        let (finished, done) = smol::channel::unbounded();
+        let _ = std::thread::Builder::new()
+            .name("check_trajectory".into())
+            .spawn(move || {
+                while let Ok((id, job)) = queue.recv() {
+                    // A panic in the check must not leave the caller without an answer.
+                    let answer = crate::limits::contain_panic(|| job.run()).unwrap_or_else(|e| CheckTrajectoryResponse {
+                        segment: -1,
+                        fraction: -1.0,
+                        error: format!("the check failed: {}", e.replace('\n', " ")),
+                        ..Default::default()
+                    });
+                    if finished.send_blocking((id, answer)).is_err() {
+                        break;
+                    }
+                }
+            })
+            .context("cannot start the check_trajectory worker thread")?;
+        Ok(TrajectoryWorker { jobs, done })
+    }
 }
 
 /// Joint states taken in one turn of the loop at most: the rest wait for the next turn, so a
@@ -451,6 +506,44 @@ impl NodeState {
         }
     }
 
+    /// A `check_trajectory` request: resolved by the pipeline here (cheap), checked by the worker.
+    /// A refused request is answered at once, as is one past [`MAX_TRAJECTORIES_PENDING`].
+    async fn on_trajectory_request(&mut self, io: &Interfaces, worker: &TrajectoryWorker, id: ros2_client::service::RmwRequestId, req: CheckTrajectoryRequest) {
+        let job = self.pipeline.trajectory_job(&req.trajectory);
+        drop(req);
+        if job.refused().is_none() {
+            match worker.jobs.try_send((id, job)) {
+                Ok(()) => return,
+                Err(std::sync::mpsc::TrySendError::Full(_)) => {
+                    let busy = CheckTrajectoryResponse {
+                        segment: -1,
+                        fraction: -1.0,
+                        error: format!("busy: {MAX_TRAJECTORIES_PENDING} check_trajectory requests are waiting; try again later"),
+                        ..Default::default()
+                    };
+                    return self.send_trajectory_answer(io, id, busy).await;
+                }
+                Err(std::sync::mpsc::TrySendError::Disconnected(_)) => {
+                    let gone =
+                        CheckTrajectoryResponse { segment: -1, fraction: -1.0, error: "the check_trajectory worker has stopped".into(), ..Default::default() };
+                    return self.send_trajectory_answer(io, id, gone).await;
+                }
+            }
+        }
+        let answer = job.run();
+        self.send_trajectory_answer(io, id, answer).await;
+    }
+
+    async fn send_trajectory_answer(&mut self, io: &Interfaces, id: ros2_client::service::RmwRequestId, answer: CheckTrajectoryResponse) {
+        if !answer.error.is_empty() {
+            let e = answer.error.clone();
+            self.log.warn("service-trajectory", || format!("{}: not valid: {e}", io.names.check_trajectory));
+        }
+        if io.check_trajectory.async_send_response(id, answer).await.is_err() {
+            self.log.warn("service-send", || format!("sending a {} response failed", io.names.check_trajectory));
+        }
+    }
+
     fn on_tick(&mut self, node: &Node, io: &Interfaces) {
         // Warnings go to /rosout too (the console already has them).
         for text in self.log.pending.drain(..) {
@@ -506,7 +599,10 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
             PoseSource::Tf => format!("/tf and /tf_static (tf2_msgs/msg/TFMessage, frame prefix '{}')", p.frame_prefix),
             PoseSource::JointStates => format!("{} (sensor_msgs/msg/JointState)", io.names.joint_states),
         };
-        println!("  subscribes {input}, publishes {} (thickness_collision_msgs/msg/CollisionReport), serves {}", io.names.collisions, io.names.check_states);
+        println!(
+            "  subscribes {input}, publishes {} (thickness_collision_msgs/msg/CollisionReport), serves {} and {}",
+            io.names.collisions, io.names.check_states, io.names.check_trajectory
+        );
     }
 
     let stop = Arc::new(AtomicBool::new(false));
@@ -534,6 +630,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         })
         .context("cannot install the Ctrl-C/SIGTERM handler")?;
     }
+    let worker = TrajectoryWorker::start()?;
     let spinner = node.spinner().map_err(|e| anyhow!("spinner: {e:?}"))?;
     let fqn = node.fully_qualified_name();
     let mut state = NodeState {
@@ -565,6 +662,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let mut descriptions: Stream<DescriptionMsg> = stream_of(Some(&io.descriptions));
         let mut clocks: Stream<ClockMsg> = stream_of(io.clock.as_ref());
         let mut requests = io.check_states.receive_request_stream();
+        let mut trajectories = io.check_trajectory.receive_request_stream();
+        let mut checked_trajectories = Box::pin(worker.done.clone());
         while !stop.load(Ordering::SeqCst) {
             state.on_tick(&node, &io);
             let tick = FutureExt::fuse(smol::Timer::after(Duration::from_millis(100)));
@@ -576,6 +675,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 m = descriptions.select_next_some() => m.map_or_else(|e| Event::ReadFailed("robot_description", e), |(m, _)| Event::Description(m)),
                 m = clocks.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/clock", e), |(m, _)| Event::Clock(m.clock)),
                 r = requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_states", e), |(id, req)| Event::Request(id, req)),
+                r = trajectories.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_trajectory", e), |(id, req)| Event::TrajectoryRequest(id, req)),
+                (id, answer) = checked_trajectories.select_next_some() => Event::TrajectoryDone(id, answer),
                 _ = tick => Event::Tick,
             };
             // A parameter change accepted before this input arrived applies to it.
@@ -587,6 +688,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 Event::Description(m) => state.on_description(&io, m),
                 Event::Clock(t) => state.sim_time = Some(t),
                 Event::Request(id, req) => state.on_request(&io, id, req).await,
+                Event::TrajectoryRequest(id, req) => state.on_trajectory_request(&io, &worker, id, req).await,
+                Event::TrajectoryDone(id, answer) => state.send_trajectory_answer(&io, id, answer).await,
                 Event::ReadFailed(what, e) => state.on_read_failed(what, &e),
                 Event::Tick => {}
             }

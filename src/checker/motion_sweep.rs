@@ -1,0 +1,152 @@
+//! The adaptive loop that joint-space motions and link-pose motions share: given a bound on how
+//! fast every point of each checked link moves along the motion parameter `s`, the link poses at
+//! any `s`, and the report of the state at any `s`, find the first stretch of the motion that
+//! cannot be cleared.
+
+use super::checker_build::Checker;
+use super::motion::{grow, MotionReport, MAX_SUBINTERVALS};
+use super::state_report::{ReportContact, StateReport};
+use crate::collision::{CollideSettings, Target, TargetShape};
+use crate::math::{Pose, Real};
+use std::collections::hash_map::{Entry, HashMap};
+
+/// A motion as the adaptive loop sees it.
+pub(super) trait MotionPath {
+    /// Per target (as `Checker::targets`): a bound on how far any point of it moves per unit of
+    /// `s`, in every part of the motion (0: the target does not move).
+    fn speeds(&self) -> &[Real];
+    /// The world poses of the robot's links at `s` (indexed like `robot().links`).
+    fn link_poses(&self, s: f64) -> Result<Vec<Option<Pose>>, String>;
+    /// A bound on how far any point of target `ti` moves from where it is at `s`, for every `s'`
+    /// with `|s' - s| <= half`, given the link poses at `s`. At most `half · speeds()[ti]`.
+    fn bound(&self, ti: usize, _poses: &[Option<Pose>], half: f64) -> Real {
+        half * self.speeds()[ti]
+    }
+    /// The report of the state at `s` (its contacts are those of a motion found colliding there).
+    fn report_at(&self, s: f64) -> StateReport;
+}
+
+/// Where a motion could not be cleared: the start of the stretch, the target, the ladder level it
+/// was grown by and its pose at the stretch's middle.
+struct Blocked {
+    fraction: f64,
+    ti: usize,
+    level: Option<usize>,
+    pose: Pose,
+}
+
+impl Checker {
+    /// The adaptive loop over `path` (see the module documentation of `motion`). Targets are
+    /// cleared one after the other, each over `[0, limit)`, where `limit` is the earliest stretch
+    /// that an earlier target could not clear: the answer is the earliest over all targets, as if
+    /// they were examined together, left half first.
+    pub(super) fn sweep_motion(&self, path: &impl MotionPath) -> MotionReport {
+        let bounds = self.motion_bounds();
+        let speed = path.speeds();
+        let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
+        let failed = |error: String, examined: u64| {
+            let mut report = StateReport::failed(error);
+            report.motion = true;
+            MotionReport { report, fraction: None, subintervals: examined }
+        };
+        // Link poses by `s`: the targets of one link chain meet at the same midpoints.
+        let mut poses_at: HashMap<u64, Vec<Option<Pose>>> = HashMap::new();
+        let mut blocked: Option<Blocked> = None;
+        let mut examined = 0u64;
+        let mut stack: Vec<(f64, f64)> = Vec::with_capacity(64);
+        for (ti, lt) in self.targets().iter().enumerate() {
+            stack.clear();
+            stack.push((0.0, 1.0));
+            while let Some((a, b)) = stack.pop() {
+                let limit = blocked.as_ref().map_or(f64::INFINITY, |b| b.fraction);
+                if a >= limit {
+                    continue;
+                }
+                examined += 1;
+                if examined > MAX_SUBINTERVALS {
+                    return failed(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"), examined);
+                }
+                let m = 0.5 * (a + b);
+                let poses = match poses_at.entry(m.to_bits()) {
+                    Entry::Occupied(e) => e.into_mut(),
+                    Entry::Vacant(e) => match path.link_poses(m) {
+                        Ok(p) => e.insert(p),
+                        Err(error) => return failed(error, examined),
+                    },
+                };
+                let Some(link_pose) = poses[lt.link] else {
+                    return failed(format!("no pose for link '{}'", lt.name), examined);
+                };
+                // A link that does not move is where it is at every s: checked as it is, ungrown
+                // (a base resting on a table is not a near miss).
+                let (level, covered) = if speed[ti] > 0.0 {
+                    let delta = path.bound(ti, poses, 0.5 * (b - a));
+                    let level = bounds.level(delta);
+                    (Some(level), bounds.growth(level) >= delta)
+                } else {
+                    (None, true)
+                };
+                if covered && !self.grown_link_hit(ti, level, &link_pose, &flags) {
+                    continue;
+                }
+                if level.is_none_or(|l| l == 0) {
+                    blocked = Some(Blocked { fraction: a, ti, level, pose: link_pose });
+                    break;
+                }
+                stack.push((m, b));
+                stack.push((a, m));
+            }
+        }
+        match blocked {
+            None => MotionReport { report: StateReport { motion: true, ..Default::default() }, fraction: None, subintervals: examined },
+            Some(b) => self.motion_contact(path.report_at(b.fraction), b.ti, b.level, &b.pose, b.fraction, examined),
+        }
+    }
+
+    /// Target `ti`'s part `pi` grown by ladder `level` (as it is for `None`).
+    fn grown_part(&self, ti: usize, pi: usize, level: Option<usize>) -> &TargetShape {
+        let (shape, _) = &self.targets()[ti].parts[pi];
+        match level {
+            None => shape,
+            Some(level) => {
+                let bounds = self.motion_bounds();
+                bounds.grown[ti][pi][level].get_or_init(|| grow(shape, bounds.growth(level)))
+            }
+        }
+    }
+
+    /// Whether target `ti`, every part grown by ladder `level`, touches anything it may not.
+    fn grown_link_hit(&self, ti: usize, level: Option<usize>, link_pose: &Pose, settings: &CollideSettings) -> bool {
+        self.targets()[ti].parts.iter().enumerate().any(|(pi, (_, offset))| {
+            let target = Target::new(self.grown_part(ti, pi, level).clone(), *link_pose * *offset);
+            !self.collide_target(ti, &target, settings).contacts.is_empty()
+        })
+    }
+
+    /// The report of a motion found colliding on the stretch starting at `fraction`: `report` is
+    /// that of the pose there; for a near miss (the link does not collide there) the object the
+    /// grown link at `link_pose` touched is added, with depth 0.
+    fn motion_contact(&self, mut report: StateReport, ti: usize, level: Option<usize>, link_pose: &Pose, fraction: f64, examined: u64) -> MotionReport {
+        if !report.contacts.iter().any(|c| c.link_name == self.targets()[ti].name) {
+            let settings = CollideSettings { flag_only: false, least_overlap: false, ..Default::default() };
+            let lt = &self.targets()[ti];
+            let near = lt.parts.iter().enumerate().find_map(|(pi, (_, offset))| {
+                self.collide_target(ti, &Target::new(self.grown_part(ti, pi, level).clone(), *link_pose * *offset), &settings).deepest().copied()
+            });
+            if let Some(c) = near {
+                report.contacts.push(ReportContact {
+                    link_name: lt.name.clone(),
+                    object_name: self.scene().objects()[c.object].name.clone(),
+                    triangle: c.triangle,
+                    depth: 0.0,
+                    position: c.position.map(|p| p.to_array()),
+                    normal: c.normal.to_array(),
+                });
+            }
+        }
+        report.in_collision = true;
+        report.motion = true;
+        report.fraction = Some(fraction);
+        MotionReport { report, fraction: Some(fraction), subintervals: examined }
+    }
+}
