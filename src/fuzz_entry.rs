@@ -22,7 +22,7 @@ use crate::math::{Pose, Vector};
 use crate::mesh::{generate, MeshTopology, TopologySettings};
 use crate::model::mesh_file::parse_mesh;
 use crate::model::{PackageResolver, Params, RobotModel};
-use crate::msgs::{JointState, StringMsg, TfMessage, Time};
+use crate::msgs::{CheckTrajectoryRequest, JointState, StringMsg, TfMessage, Time};
 use crate::pipeline::{parse_state_line, Pipeline, RobotState};
 use crate::replay::{decode_cdr, open_bag};
 use crate::thickness::{ThicknessArea, ThicknessSettings};
@@ -46,6 +46,7 @@ pub const TARGETS: &[(&str, Entry)] = &[
     ("params_yaml", params_yaml),
     ("bag_mcap", bag_mcap),
     ("bag_sqlite", bag_sqlite),
+    ("check_trajectory", check_trajectory),
 ];
 
 /// Printed before a panic the library contained (mesh-loader), once per message.
@@ -404,6 +405,32 @@ pub fn bag_sqlite(data: &[u8]) {
     bag(data, "fuzz.db3");
 }
 
+/// Points of a fuzzed trajectory checked against the workcell (all of them are validated, and
+/// checked against an empty environment): a segment of made-up positions can need the motion
+/// check's full 2^20 sub-intervals, seconds each.
+const TRAJECTORY_POINTS_ON_WORKCELL: usize = 4;
+
+/// A `check_trajectory` request: a CDR payload (with its 4-byte encapsulation header) decoded as
+/// the node decodes it, resolved against a fresh pipeline that has merged one partial joint state
+/// (so joints left out come from the current state, others from `missing_joint`), walked in full
+/// against an empty environment, and its first [`TRAJECTORY_POINTS_ON_WORKCELL`] points walked
+/// against the workcell.
+pub fn check_trajectory(data: &[u8]) {
+    let Ok(request) = decode_cdr::<CheckTrajectoryRequest>(data) else { return };
+    let mut pipeline = fresh_pipeline();
+    let first = pipeline.checker().robot().joints.iter().find(|j| j.is_actuated()).map(|j| j.name.clone());
+    if let Some(name) = first {
+        let _ = pipeline.joint_state(&JointState { name: vec![name], position: vec![0.25], ..Default::default() });
+    }
+    let answer = pipeline.check_trajectory(&request.trajectory);
+    // A refused request is never valid, and says why.
+    assert!(answer.valid || !answer.error.is_empty() || answer.segment >= 0, "an invalid answer without a cause: {answer:?}");
+    assert!(!answer.valid || (answer.segment == -1 && answer.error.is_empty()), "a valid answer with a segment or an error: {answer:?}");
+    let mut head = request.trajectory;
+    head.points.truncate(TRAJECTORY_POINTS_ON_WORKCELL);
+    let _ = workcell().check_trajectory(&head);
+}
+
 /// Seed inputs for every target, generated from the bundled workcell and the library's own
 /// encoders: (target, file name, bytes). `tests/fuzz_regressions.rs` writes them to
 /// `fuzz/corpus/<target>/` (`scripts/fuzz_campaign.sh` asks it to); the bag seeds, written by
@@ -531,6 +558,31 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
         out.push(("state_line", format!("{name}.json"), line.to_string().into_bytes()));
     }
 
+    // Trajectories: every joint through the workcell (into a guard), a partial one, one point,
+    // and refused ones (lengths, time going back, NaN, an unknown joint).
+    {
+        use crate::msgs::{DurationMsg, JointTrajectory, JointTrajectoryPoint};
+        let point = |positions: Vec<f64>, sec: i32| JointTrajectoryPoint { positions, time_from_start: DurationMsg { sec, nanosec: 0 }, ..Default::default() };
+        let request = |joint_names: Vec<String>, points: Vec<JointTrajectoryPoint>| {
+            encode_cdr_le(&CheckTrajectoryRequest { trajectory: JointTrajectory { header: header("world"), joint_names, points } })
+        };
+        let lift_elbow = vec!["shoulder_lift_joint".to_string(), "elbow_joint".to_string()];
+        let wave: Vec<JointTrajectoryPoint> =
+            (0..5).map(|k| point(names.iter().enumerate().map(|(i, _)| 0.2 * (k * (i + 1)) as f64).collect(), k as i32)).collect();
+        let trajectories = [
+            ("every_joint", request(names.clone(), wave)),
+            ("into_guard", request(lift_elbow.clone(), vec![point(vec![0.0, 0.0], 0), point(vec![0.2, 0.1], 1), point(vec![1.2, 0.3], 3)])),
+            ("one_point", request(lift_elbow.clone(), vec![point(vec![1.2, 0.3], 2)])),
+            ("lengths", request(lift_elbow.clone(), vec![point(vec![0.0], 0)])),
+            ("time_back", request(lift_elbow.clone(), vec![point(vec![0.0, 0.0], 2), point(vec![0.1, 0.0], 1)])),
+            ("nan", request(lift_elbow.clone(), vec![point(vec![0.0, f64::NAN], 0)])),
+            ("unknown_joint", request(vec!["no_such_joint".into()], vec![point(vec![0.0], 0)])),
+        ];
+        for (name, bytes) in trajectories {
+            out.push(("check_trajectory", format!("{name}.cdr"), bytes));
+        }
+    }
+
     // Parameters: the bundled file and the defaults written out.
     let params = std::fs::read(crate::model::bundled_config_dir().join("params.yaml")).unwrap_or_default();
     out.push(("params_yaml", "params.yaml".into(), params));
@@ -541,6 +593,23 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn trajectory_seeds_decode_and_reach_the_check() {
+        let mut seen = 0;
+        for (_, name, bytes) in seeds().into_iter().filter(|s| s.0 == "check_trajectory") {
+            let request = decode_cdr::<CheckTrajectoryRequest>(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let a = workcell().check_trajectory(&request.trajectory);
+            match name.as_str() {
+                "every_joint.cdr" => assert!(a.valid || a.segment >= 0, "{name}: {a:?}"),
+                "into_guard.cdr" => assert!(!a.valid && a.segment == 1 && a.error.is_empty() && !a.contacts.is_empty(), "{name}: {a:?}"),
+                "one_point.cdr" => assert!(!a.valid && a.segment == 0 && a.fraction == 0.0, "{name}: {a:?}"),
+                _ => assert!(!a.valid && a.segment == -1 && !a.error.is_empty(), "{name}: {a:?}"),
+            }
+            seen += 1;
+        }
+        assert_eq!(seen, 7);
+    }
 
     #[test]
     fn records_split_back() {

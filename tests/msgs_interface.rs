@@ -13,6 +13,8 @@ fn msg_and_srv_files_parse_with_rosbags() {
         "thickness_collision_msgs/msg/CollisionReport",
         "thickness_collision_msgs/srv/CheckStates_Request",
         "thickness_collision_msgs/srv/CheckStates_Response",
+        "thickness_collision_msgs/srv/CheckTrajectory_Request",
+        "thickness_collision_msgs/srv/CheckTrajectory_Response",
     ] {
         let parsed: Vec<&str> = types[name].as_array().unwrap_or_else(|| panic!("{name} missing: {types}")).iter().map(|v| v.as_str().unwrap()).collect();
         // rosbags files service parts under `pkg/srv/msg/Type`.
@@ -30,4 +32,51 @@ fn msg_and_srv_files_parse_with_rosbags() {
     let v = serde_json::to_value(&c).unwrap();
     let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
     assert_eq!(keys.len(), 6);
+}
+
+/// `CheckTrajectory.srv`'s two parts against the serde structs the node sends and receives (field
+/// order is wire order), and its types against the ROS packages the interface package depends on.
+#[test]
+fn check_trajectory_srv_matches_the_rust_types() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let text = std::fs::read_to_string(format!("{root}/interfaces/thickness_collision_msgs/srv/CheckTrajectory.srv")).unwrap();
+    let (request, response) = text.split_once("---").unwrap();
+    let fields = |part: &str| -> Vec<(String, String)> {
+        part.lines()
+            .filter_map(|l| l.split('#').next())
+            .filter_map(|l| {
+                let mut w = l.split_whitespace();
+                Some((w.next()?.to_owned(), w.next()?.to_owned()))
+            })
+            .collect()
+    };
+    // The struct's fields in serialisation order (a `Value` would sort them): where each name
+    // first appears in the JSON text, the nested ones left out by taking only top-level names.
+    let keys = |text: String| -> Vec<String> {
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let mut names: Vec<(usize, String)> = v.as_object().unwrap().keys().map(|k| (text.find(&format!("\"{k}\":")).unwrap(), k.clone())).collect();
+        names.sort();
+        names.into_iter().map(|n| n.1).collect()
+    };
+    let (req, resp) = (fields(request), fields(response));
+    assert_eq!(req, [("trajectory_msgs/JointTrajectory".to_owned(), "trajectory".to_owned())]);
+    let req_keys = keys(serde_json::to_string(&thickness_collision::msgs::CheckTrajectoryRequest::default()).unwrap());
+    assert_eq!(req.iter().map(|f| f.1.clone()).collect::<Vec<_>>(), req_keys);
+    let resp_keys = keys(serde_json::to_string(&thickness_collision::msgs::CheckTrajectoryResponse::default()).unwrap());
+    assert_eq!(resp.iter().map(|f| f.1.clone()).collect::<Vec<_>>(), resp_keys);
+    let types: Vec<&str> = resp.iter().map(|f| f.0.as_str()).collect();
+    assert_eq!(types, ["bool", "int32", "float64", "builtin_interfaces/Duration", "Contact[]", "string"]);
+    // trajectory_msgs/JointTrajectory and JointTrajectoryPoint as ROS defines them.
+    let traj = keys(serde_json::to_string(&thickness_collision::msgs::JointTrajectory::default()).unwrap());
+    assert_eq!(traj, ["header", "joint_names", "points"]);
+    let point = keys(serde_json::to_string(&thickness_collision::msgs::JointTrajectoryPoint::default()).unwrap());
+    assert_eq!(point, ["positions", "velocities", "accelerations", "effort", "time_from_start"]);
+    // The interface package declares the packages the service uses.
+    let cmake = std::fs::read_to_string(format!("{root}/interfaces/thickness_collision_msgs/CMakeLists.txt")).unwrap();
+    let package = std::fs::read_to_string(format!("{root}/interfaces/thickness_collision_msgs/package.xml")).unwrap();
+    for dep in ["trajectory_msgs", "builtin_interfaces"] {
+        assert!(cmake.contains(&format!("find_package({dep} REQUIRED)")) && cmake.contains(&format!(" {dep}")), "CMakeLists.txt: {dep}");
+        assert!(package.contains(&format!("<depend>{dep}</depend>")), "package.xml: {dep}");
+    }
+    assert!(cmake.contains("\"srv/CheckTrajectory.srv\""));
 }

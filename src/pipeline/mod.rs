@@ -14,11 +14,13 @@ mod skip;
 mod state_line;
 mod state_pipeline;
 mod tf_tree;
+mod trajectory;
 
 pub use self::report_adapter::{report_message, CheckedState};
 pub use self::skip::{Skip, SkipCause};
 pub use self::state_line::{parse_state_line, LinkTransform, StateLine};
 pub use self::state_pipeline::{Pipeline, RobotState};
+pub use self::trajectory::{TrajectoryJob, MAX_TRAJECTORY_NAMES, MAX_TRAJECTORY_POINTS};
 
 #[cfg(test)]
 mod pipeline_tests;

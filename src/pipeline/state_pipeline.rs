@@ -240,6 +240,11 @@ impl Pipeline {
         }
         self.checker = Arc::new(checker);
     }
+
+    /// The merged joint positions received so far, by joint index (`None`: none yet).
+    pub(crate) fn current_joints(&self) -> &[Option<f64>] {
+        self.joints.current()
+    }
 }
 
 impl std::fmt::Debug for Pipeline {

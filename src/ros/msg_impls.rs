@@ -1,8 +1,9 @@
 //! The shared message types are ROS messages for ros2-client, and the node's own: the
-//! `check_states` service, `/clock`, and `robot_description` decoded with its size bound.
+//! `check_states` service, `/clock`, and `robot_description` decoded with its size bound (the
+//! `check_trajectory` types live in `msgs`, beside the trajectory they carry).
 
 use crate::limits::MAX_DESCRIPTION_BYTES;
-use crate::msgs::{CollisionReport, DiagnosticArray, JointState, MarkerArray, StringMsg, TfMessage};
+use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, StringMsg, TfMessage};
 use serde::{Deserialize, Serialize};
 
 impl ros2_client::Message for JointState {}
@@ -11,6 +12,8 @@ impl ros2_client::Message for TfMessage {}
 impl ros2_client::Message for StringMsg {}
 impl ros2_client::Message for MarkerArray {}
 impl ros2_client::Message for DiagnosticArray {}
+impl ros2_client::Message for CheckTrajectoryRequest {}
+impl ros2_client::Message for CheckTrajectoryResponse {}
 
 /// `thickness_collision_msgs/srv/CheckStates` request.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]

@@ -97,3 +97,24 @@ Clock = struct_typed("rosgraph_msgs/msg/Clock", [("clock", Time)])
 # check_states without the Cyclone header, for the "enhanced" mapping.
 RequestEnhanced = struct_typed("thickness_collision_msgs/srv/CheckStates_Request", [("states", t.sequence[JointState])])
 ResponseEnhanced = struct_typed("thickness_collision_msgs/srv/CheckStates_Response", [("reports", t.sequence[CollisionReport])])
+
+# check_trajectory: trajectory_msgs, and the service's parts built from CheckTrajectory.srv.
+JointTrajectoryPoint = struct_typed("trajectory_msgs/msg/JointTrajectoryPoint", [
+    ("positions", t.sequence[t.float64]), ("velocities", t.sequence[t.float64]), ("accelerations", t.sequence[t.float64]),
+    ("effort", t.sequence[t.float64]), ("time_from_start", DurationMsg)])
+JointTrajectory = struct_typed("trajectory_msgs/msg/JointTrajectory", [("header", Header), ("joint_names", t.sequence[str]),
+                                                                       ("points", t.sequence[JointTrajectoryPoint])])
+KNOWN["builtin_interfaces/Duration"] = DurationMsg
+KNOWN["trajectory_msgs/JointTrajectory"] = JointTrajectory
+_traj_req, _traj_resp = (IFACE / "srv/CheckTrajectory.srv").read_text().split("---")
+TrajReqBody = from_msg("thickness_collision_msgs", "srv", "CheckTrajectory_Request", _traj_req, local)
+TrajRespBody = from_msg("thickness_collision_msgs", "srv", "CheckTrajectory_Response", _traj_resp, local)
+
+
+def _with_header(ros_type, body):
+    """The Cyclone request/reply mapping: a (guid, seq) header before the .srv's fields."""
+    return struct_typed(ros_type, [("guid", t.uint64), ("seq", t.int64)] + list(body.__annotations__.items()))
+
+
+TrajRequest = _with_header("thickness_collision_msgs/srv/CheckTrajectory_Request", TrajReqBody)
+TrajResponse = _with_header("thickness_collision_msgs/srv/CheckTrajectory_Response", TrajRespBody)
