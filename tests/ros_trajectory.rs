@@ -283,7 +283,8 @@ fn a_long_trajectory_is_checked_while_the_live_stream_goes_on() {
     let arm = Arm::new();
     let mut rng = Rand64::new(99);
     // Back and forth between two free states whose motion is free (both ways), repeated until the
-    // check takes some 4 s on this machine (measured here; at most 65,536 points).
+    // check takes some 6 s on this machine as measured here (the node took 2-3 s in practice; at
+    // most 65,536 points).
     let a = arm.free_step(&mut rng, None, 0.0);
     let b = arm.free_step(&mut rng, Some(&a), 0.6);
     assert!(arm.motion_free(&b, &a));
@@ -294,7 +295,7 @@ fn a_long_trajectory_is_checked_while_the_live_stream_goes_on() {
         runs += 1;
     }
     let per_segment = started.elapsed().as_secs_f64() / runs as f64;
-    let points = ((4.0 / per_segment) as usize).clamp(100, 65_536);
+    let points = ((6.0 / per_segment) as usize).clamp(100, 65_536);
     let waypoints: Vec<Vec<f64>> = (0..points).map(|k| if k % 2 == 0 { a.clone() } else { b.clone() }).collect();
     eprintln!("{points} points, {:.3} ms per segment here", per_segment * 1e3);
     // The live stream meanwhile: the two states in turn, one every 50 ms until the answer.
@@ -309,9 +310,12 @@ fn a_long_trajectory_is_checked_while_the_live_stream_goes_on() {
     assert_eq!((&long["answer"]["valid"], &long["answer"]["segment"]), (&json!(true), &json!(-1)), "{long}");
     let seconds = long["seconds"].as_f64().unwrap();
     assert!(seconds >= 1.0, "the check must take a while for this test to mean anything ({seconds} s)");
-    // Reports kept coming while the trajectory was checked: never a gap of a second.
+    // Reports kept coming while the trajectory was checked.
     let before = long["reports_before_answer"].as_u64().unwrap();
     let sent = long["states_sent"].as_u64().unwrap();
     assert!(before >= 10 && before * 3 >= sent, "{before} reports for {sent} states in {seconds} s while the trajectory was checked: {long}");
-    assert!(long["max_report_gap"].as_f64().unwrap() < 1.0, "the live stream stalled: {long}");
+    // Each report came soon after the state it is stamped with was sent (the node's check of a
+    // state takes milliseconds; a stalled loop would hold them for the whole trajectory).
+    assert!(long["latencies"].as_u64().unwrap() >= 10, "{long}");
+    assert!(long["max_latency"].as_f64().unwrap() < 1.0, "the live stream stalled: {long}");
 }

@@ -9,7 +9,8 @@ stdin: {"domain": id, "state": {"name", "position", "stamp"} (published first, u
         T = {"joint_names": [...], "points": [{"positions": [...], "t": ns}]}; a position may be
         the string "NaN".
 stdout: {"state_report": report or null, "answers": [A...], "long": {"answer": A, "seconds": s,
-        "reports_before_answer": n, "states_sent": n, "max_report_gap": s}}
+        "reports_before_answer": n, "states_sent": n, "max_report_gap": s,
+        "max_latency": s (a report after the sending of the state it is stamped with), "latencies": n}}
         A = {"valid", "segment", "fraction", "time_from_start": ns, "contacts": [...], "error"}
 """
 import json
@@ -118,29 +119,39 @@ for tr in req.get("trajectories", []):
     r = wait_answer(send(tr), max(1.0, end - time.time()))
     out["answers"].append(None if r is None else answer_json(r))
 
-# A long trajectory, and the live stream while it is checked.
+# A long trajectory, and the live stream while it is checked: each report's latency (from the
+# sending of the state it is stamped with), measured from when the request has been written.
 if req.get("long"):
     reports_r.take(N=1000)
+    seq += 1
+    k = seq
+    message = d.TrajRequest(guid=GUID, seq=k, trajectory=trajectory(req["long"]))
+    req_w.write(message)
     t0 = time.time()
-    k = send(req["long"])
-    answer, answered_at, arrivals = None, None, []
+    answer, answered_at, arrivals, latencies, sent_at = None, None, [], [], {}
     stream = req.get("stream", [])
     i = 0
     while time.time() < end and answer is None:
         if stream:
             # Cycled, stamped 50 ms apart from the first one's stamp.
             st = dict(stream[i % len(stream)], stamp=int(stream[0]["stamp"]) + 50_000_000 * i)
+            sent_at[st["stamp"]] = time.time()
             states_w.write(js(st))
             i += 1
         stop = time.time() + 0.05
         while time.time() < stop and answer is None:
-            for _ in reports_r.take(N=100):
-                arrivals.append(time.time() - t0)
+            for r in reports_r.take(N=100):
+                now = time.time()
+                arrivals.append(now - t0)
+                sent = sent_at.get(r.header.stamp.sec * 1_000_000_000 + r.header.stamp.nanosec)
+                if sent is not None:
+                    latencies.append(now - sent)
             for x in resp_r.take(N=10):
                 if int(x.seq) == k:
                     answer, answered_at = x, time.time() - t0
             time.sleep(0.002)
-    gaps = [b - a for a, b in zip([0.0] + arrivals, arrivals)]
+    gaps = [b - a for a, b in zip(arrivals, arrivals[1:])]
     out["long"] = {"answer": None if answer is None else answer_json(answer), "seconds": answered_at,
-                   "reports_before_answer": len(arrivals), "states_sent": i, "max_report_gap": max(gaps) if gaps else None}
+                   "reports_before_answer": len(arrivals), "states_sent": i, "max_report_gap": max(gaps) if gaps else None,
+                   "max_latency": max(latencies) if latencies else None, "latencies": len(latencies)}
 json.dump(out, sys.stdout)
