@@ -84,6 +84,9 @@ fn main() {
             start: None,
             end: None,
             progress: false,
+            // States on their own, as the figures in docs/benchmarks.md were taken; motions are
+            // measured in benches/motion.rs.
+            motion: Some(false),
         };
         let started = Instant::now();
         let summary = replay(Params::default(), None, None, &opts).unwrap();

@@ -104,6 +104,12 @@ enum Command {
         /// Seconds after the bag's first message to stop at.
         #[arg(long)]
         end: Option<f64>,
+        /// Check the motion between consecutive states (default: the parameters' check_motion).
+        #[arg(long, overrides_with = "no_motion")]
+        motion: bool,
+        /// Check every state on its own, not the motions between them.
+        #[arg(long, overrides_with = "motion")]
+        no_motion: bool,
     },
 }
 
@@ -147,8 +153,15 @@ fn run(cli: Cli) -> Result<()> {
         }
         #[cfg(feature = "ros")]
         Command::Run { model, ros_args } => cli::run::run(&model, &ros_args),
-        Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, jsonl, start, end } => {
-            let opts = thickness_collision::replay::ReplayOptions { bag, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, progress: true };
+        Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, motion, no_motion } => {
+            let motion = if motion {
+                Some(true)
+            } else if no_motion {
+                Some(false)
+            } else {
+                None
+            };
+            let opts = thickness_collision::replay::ReplayOptions { bag, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, progress: true, motion };
             cli::replay::replay(&model, &opts)
         }
     }

@@ -256,7 +256,8 @@ fn a_robot_description_in_the_bag_applies_from_its_log_time() {
     let mut messages = states.clone();
     let at = states[20]["t"].as_i64().unwrap() - 1;
     messages.insert(20, json!({"topic": "/robot_description", "t": at, "data": urdf}));
-    let params = params_file(&d, "    missing_joint: last\n");
+    // States on their own, as `check` without `--motion` gives them.
+    let params = params_file(&d, "    missing_joint: last\n    check_motion: false\n");
     let (lines, _) = replayed(&messages, &params, &d, "mcap");
     // check on the same states: the parameters' robot, and the fat one.
     let file = d.join("states.jsonl");
@@ -277,4 +278,110 @@ fn a_robot_description_in_the_bag_applies_from_its_log_time() {
     assert!(differ(0..20) > 0 && differ(20..40) > 0, "the fat forearm must change some answers on both sides");
     same_reports(&lines[..20], &thin[..20], "before the description");
     same_reports(&lines[20..], &fat[20..], "after the description");
+}
+
+/// The bundled arm at three states (every joint but the finger's mimic): A and C close together
+/// in front of the workcell's surfaces, B on the far side. Each state is free and so is the
+/// straight motion A → C, but A → B crosses the guard sheet and B → C the shelf: a node that
+/// drops B when it falls behind reports a free motion that was not.
+const TRIPLE: [[f64; 7]; 3] = [
+    [2.3262656677907794, 0.6818684280582978, 2.39428789294752, 2.276771623960049, 1.4581508272089656, 1.2689149002932716, 0.01847976994306216],
+    [-2.636566638810667, -0.5700379417947858, 1.5543806482359694, 1.5653099275652815, -0.5548617135963831, -2.789680498270184, 0.03316370801149869],
+    [2.3489918091071202, 0.7010671794714393, 2.385904178256132, 2.285909494944286, 1.4359962858749236, 1.257838600196322, 0.01883300333765152],
+];
+const TOOL0: [f64; 3] = [-1.915057823936282, -1.8962443176668413, -1.9291643109626693];
+
+fn triple_names() -> Vec<&'static str> {
+    let mut names = ARM.to_vec();
+    names.extend([FINGER, "tool0_joint"]);
+    names
+}
+
+fn triple_state(i: usize) -> Vec<f64> {
+    let mut q = TRIPLE[i].to_vec();
+    q.push(TOOL0[i]);
+    q
+}
+
+/// `check --states` (with `--motion` or not) on the given states of [`TRIPLE`], as JSON reports.
+fn check_path(order: &[usize], motion: bool, d: &Path) -> Vec<Value> {
+    let f = d.join("triple.jsonl");
+    let lines: Vec<String> = order.iter().map(|&i| json!({"name": triple_names(), "position": triple_state(i)}).to_string()).collect();
+    std::fs::write(&f, lines.join("\n") + "\n").unwrap();
+    let mut cmd = bin();
+    let _ = cmd.args(["check", "--json", "--states", f.to_str().unwrap()]);
+    if motion {
+        let _ = cmd.arg("--motion");
+    }
+    let o = cmd.output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+}
+
+/// Issue 12: states published faster than the node checks them. Each round sends A, B and C back
+/// to back; when the node takes B and C together it reports once, and that report must cover B
+/// (the polyline A → B → C), not only C. With `check_motion:=false` the same rounds show what is
+/// missed without it.
+#[test]
+fn a_state_the_node_falls_behind_on_is_still_covered_by_the_next_report() {
+    let d = dir("skipped");
+    // The premises, from `check`: every state free, A → C free, A → B and B → C not.
+    let discrete = check_path(&[0, 1, 2], false, &d);
+    assert!(discrete.iter().all(|r| r["in_collision"] == false), "{discrete:?}");
+    let straight = check_path(&[0, 2, 0], true, &d);
+    assert!(straight.iter().all(|r| r["in_collision"] == false), "A -> C -> A: {straight:?}");
+    let through = check_path(&[0, 1, 2], true, &d);
+    assert!(through[1]["in_collision"] == true && through[2]["in_collision"] == true, "A -> B -> C: {through:?}");
+
+    const ROUNDS: usize = 60;
+    let mut messages = Vec::new();
+    let mut b_stamps = Vec::new();
+    let mut k = 0;
+    let msg = |i: usize, burst: bool, k: &mut usize| {
+        let t = T0 + *k as i64 * 10_000_000;
+        *k += 1;
+        json!({"topic": "/joint_states", "t": t, "stamp": t, "name": triple_names(), "position": nums(&triple_state(i)), "burst": burst})
+    };
+    messages.push(msg(0, false, &mut k)); // the warm-up
+    for _ in 0..ROUNDS {
+        messages.push(msg(0, true, &mut k));
+        b_stamps.push(T0 + k as i64 * 10_000_000);
+        messages.push(msg(1, true, &mut k));
+        messages.push(msg(2, false, &mut k));
+    }
+    for motion in [true, false] {
+        // Domains of their own (the other tests here use 120-199).
+        let domain = if motion { 70 } else { 90 } + std::process::id() % 20;
+        let (mut node, _out, _banner) = common::start_node(&["--ros-args", "-p", &format!("check_motion:={motion}")], domain);
+        let answer = peer(&json!({"op": "live", "domain": domain, "messages": messages, "timeout": 30}), Some(&cyclone_config(&d)));
+        let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
+        assert!(node.wait().unwrap().success());
+        let reports: Vec<Value> = answer["reports"].as_array().unwrap().iter().filter(|r| r["stamp"].as_i64() > Some(T0)).cloned().collect();
+        let received: u64 = answer["diagnostics"]["states_received"].as_str().and_then(|s| s.parse().ok()).unwrap_or(0);
+        // Every state reached the node (best-effort on loopback, three at a time): a state lost
+        // in transport is covered by nothing, and the test could not tell.
+        assert!(received > 3 * ROUNDS as u64, "check_motion {motion}: the node received {received} states of {}", 1 + 3 * ROUNDS);
+        let mut skipped_b = 0;
+        for (round, &tb) in b_stamps.iter().enumerate() {
+            let first = reports.iter().find(|r| r["stamp"].as_i64().is_some_and(|s| s >= tb));
+            let first = first.unwrap_or_else(|| panic!("check_motion {motion}: no report at or after B of round {round}: {reports:?}"));
+            let skipped = first["stamp"].as_i64() != Some(tb);
+            skipped_b += usize::from(skipped);
+            if motion {
+                assert!(
+                    first["in_collision"] == true && first["motion"] == true && first["error"] == "",
+                    "round {round}: the report covering B (skipped: {skipped}) is {first}"
+                );
+                let f = first["fraction"].as_f64().unwrap();
+                assert!((0.0..=1.0).contains(&f), "round {round}: fraction {f}");
+            } else if skipped {
+                // What a discrete check misses: only C is checked, and it is free.
+                assert!(first["in_collision"] == false && first["motion"] == false, "round {round}, discrete: {first}");
+            }
+        }
+        eprintln!("check_motion {motion}: {} reports for {} states; B not reported on its own in {skipped_b} of {ROUNDS} rounds", reports.len(), 3 * ROUNDS);
+        if motion {
+            assert!(skipped_b > 0, "the node kept up with every state, so no report had to cover a state it skipped: {reports:?}");
+        }
+    }
 }

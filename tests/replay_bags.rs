@@ -61,9 +61,13 @@ fn state_lines(states: &[(Vec<String>, Vec<f64>)]) -> Vec<String> {
 }
 
 fn check_reference(d: &Path, lines: &[String]) -> Vec<String> {
+    check_reference_with(d, lines, &[])
+}
+
+fn check_reference_with(d: &Path, lines: &[String], extra: &[&str]) -> Vec<String> {
     let f = d.join("states.jsonl");
     std::fs::write(&f, lines.join("\n") + "\n").unwrap();
-    ok(bin().args(["check", "--states", f.to_str().unwrap(), "--json"]).output().unwrap()).lines().map(str::to_owned).collect()
+    ok(bin().args(["check", "--states", f.to_str().unwrap(), "--json"]).args(extra).output().unwrap()).lines().map(str::to_owned).collect()
 }
 
 fn write_bag(path: &Path, storage: &str, messages: &[Value], description: Option<String>) {
@@ -78,8 +82,15 @@ fn same_lines(got: &[String], want: &[String], what: &str) {
     assert_eq!(got.len(), want.len(), "{what}: line count");
 }
 
+/// `replay BAG extra...`: states on their own (`--no-motion`, as `check` without `--motion`
+/// gives them) unless `extra` asks for `--motion`.
 fn replay(bag: &Path, extra: &[&str]) -> Output {
-    bin().arg("replay").arg(bag).args(extra).output().unwrap()
+    let mut c = bin();
+    let _ = c.arg("replay").arg(bag).args(extra);
+    if !extra.contains(&"--motion") {
+        let _ = c.arg("--no-motion");
+    }
+    c.output().unwrap()
 }
 
 #[test]
@@ -89,6 +100,11 @@ fn joint_state_bags_replay_like_check_and_read_back() {
     let reference = check_reference(&d, &state_lines(&st));
     let colliding = reference.iter().filter(|l| l.contains("\"in_collision\":true")).count();
     assert!(colliding > 40 && colliding < 360, "{colliding} of 400 colliding: pick another seed");
+    let motion_reference = check_reference_with(&d, &state_lines(&st), &["--motion"]);
+    let motions = motion_reference.iter().skip(1).filter(|l| l.contains("\"motion\":true")).count();
+    let moving_hits = motion_reference.iter().filter(|l| l.contains("\"in_collision\":true")).count();
+    assert_eq!(motions, 399, "every state after the first is a motion");
+    assert!(moving_hits >= colliding, "a motion into a colliding state collides: {moving_hits} < {colliding}");
     let msgs = joint_messages(&st);
     for storage in ["mcap", "sqlite3"] {
         let bag = d.join(format!("in_{storage}"));
@@ -99,6 +115,12 @@ fn joint_state_bags_replay_like_check_and_read_back() {
         assert!(summary.contains(&format!("states: 400, in collision: {colliding}")), "{summary}");
         let got: Vec<String> = std::fs::read_to_string(&jsonl).unwrap().lines().map(str::to_owned).collect();
         same_lines(&got, &reference, &format!("{storage}: replay vs check"));
+        // With motions (the parameters' default): replay's report of each state covers the
+        // motion from the one before, as `check --motion` gives it for the same path.
+        let moving = d.join(format!("motion_{storage}.jsonl"));
+        let _ = ok(replay(&bag, &["--motion", "--jsonl", moving.to_str().unwrap()]));
+        let got: Vec<String> = std::fs::read_to_string(&moving).unwrap().lines().map(str::to_owned).collect();
+        same_lines(&got, &motion_reference, &format!("{storage}: replay --motion vs check --motion"));
         // Deterministic: byte-identical JSON lines.
         let again = d.join(format!("again_{storage}.jsonl"));
         let _ = ok(replay(&bag, &["--jsonl", again.to_str().unwrap()]));

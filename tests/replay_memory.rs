@@ -69,7 +69,13 @@ fn replay_peak(bag: &Path, d: &Path) -> (u64, f64, String) {
     } else {
         Command::new(exe)
     };
-    let _ = cmd.arg("replay").arg(bag).stdin(Stdio::null()).stdout(std::fs::File::create(&out).unwrap()).stderr(std::fs::File::create(&err).unwrap());
+    let _ = cmd
+        .arg("replay")
+        .arg(bag)
+        .arg("--no-motion")
+        .stdin(Stdio::null())
+        .stdout(std::fs::File::create(&out).unwrap())
+        .stderr(std::fs::File::create(&err).unwrap());
     let started = Instant::now();
     let child = cmd.spawn().expect("start replay");
     let (status, wait4_kib) = if time.exists() {

@@ -1,7 +1,8 @@
 //! The node against an independent ROS 2 participant: Cyclone DDS from Python publishes
 //! `sensor_msgs/JointState` on `rt/joint_states`, reads `rt/collisions` with types built from the
 //! project's own `.msg` files, and calls `check_states` (Cyclone's request/reply mapping). The
-//! reports equal `check --json` on the same states. Loopback only: the node gets
+//! reports equal `check --json` on the same states (the node runs with `check_motion:=false`, one
+//! report per state; motions on the node: `tests/one_pipeline.rs`). Loopback only: the node gets
 //! `ROS_LOCALHOST_ONLY=1` and `ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`, Cyclone a config with
 //! `NetworkInterface 127.0.0.1`, no multicast and the peer 127.0.0.1.
 
@@ -48,7 +49,8 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     let domain = 100 + std::process::id() % 50;
     let params = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/params.yaml");
 
-    let (mut node, mut out, banner) = start_node(&["--ros-args", "-r", "__node:=tc_test", "--params-file", params.to_str().unwrap()], domain);
+    let (mut node, mut out, banner) =
+        start_node(&["--ros-args", "-r", "__node:=tc_test", "--params-file", params.to_str().unwrap(), "-p", "check_motion:=false"], domain);
     assert!(banner.contains("/tc_test") && banner.contains("loopback only"), "{banner}");
 
     // The states, and check's answer for them.
@@ -187,6 +189,8 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     let (mut node, _out, banner) = start_node(
         &[
             "--ros-args",
+            "-p",
+            "check_motion:=false",
             "-r",
             "__ns:=/robot1",
             "-p",
@@ -269,7 +273,7 @@ fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
     let fat = dir.join("fat_arm.urdf");
     std::fs::write(&fat, &urdf).unwrap();
 
-    let (mut node, mut out, _banner) = start_node(&[], domain);
+    let (mut node, mut out, _banner) = start_node(&["--ros-args", "-p", "check_motion:=false"], domain);
     let states: Vec<(Vec<&str>, Vec<f64>)> = (0..15).map(state).collect();
     let lines: Vec<String> = states.iter().map(|(n, p)| json!({"name": n, "position": p}).to_string()).collect();
     let file = dir.join("states.jsonl");

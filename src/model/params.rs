@@ -130,6 +130,11 @@ pub struct Params {
     /// A motion is reported colliding when a pose along it comes within this distance of a cell
     /// or solid, and free only when no pose does (metres).
     pub motion_tolerance: f64,
+    /// The node and replay check the motion between consecutive states (`replay --motion` /
+    /// `--no-motion` override it).
+    pub check_motion: bool,
+    /// Stamps further apart than this (seconds) are checked as separate states, not as a motion.
+    pub motion_max_gap: f64,
 }
 
 impl Default for Params {
@@ -156,9 +161,14 @@ impl Default for Params {
             use_sim_time: false,
             service_mapping: ServiceMapping::Cyclone,
             motion_tolerance: 0.001,
+            check_motion: true,
+            motion_max_gap: 0.5,
         }
     }
 }
+
+/// Longest `motion_max_gap` (s): an hour between two states is no motion anyone recorded.
+const MAX_MOTION_GAP: f64 = 3600.0;
 
 /// Marker rates outside this range (Hz) are refused: below it a period overflows a `Duration`
 /// long before anyone would wait for it, above it the markers would cost more than the checks.
@@ -254,6 +264,9 @@ impl Params {
         }
         if !(1e-6..=0.1).contains(&self.motion_tolerance) {
             return bad("motion_tolerance", format!("must be from 1e-6 to 0.1 m, got {}", crate::limits::show_number(self.motion_tolerance)));
+        }
+        if !(0.0..=MAX_MOTION_GAP).contains(&self.motion_max_gap) {
+            return bad("motion_max_gap", format!("must be from 0 to {MAX_MOTION_GAP} s, got {}", crate::limits::show_number(self.motion_max_gap)));
         }
         if let Some(p) = self.padding.values.iter().find(|p| !(**p >= 0.0 && **p <= hi)) {
             return bad("padding.values", format!("must be from 0 to {hi:e} m, got {p:?}"));

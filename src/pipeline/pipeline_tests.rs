@@ -206,3 +206,97 @@ fn service_states_fail_closed_in_their_slots() {
     assert!(!reports[3].in_collision && reports[3].error.is_empty());
     assert_eq!(reports.iter().map(|r| r.header.stamp.as_nanos()).collect::<Vec<_>>(), vec![1, 2, 3, 4]);
 }
+
+/// The bundled arm (every joint but the finger's mimic) at A and C, close together and free, and
+/// B, free, on the far side of the guard sheet and the shelf from them (as in
+/// tests/one_pipeline.rs).
+const TRIPLE_NAMES: [&str; 8] =
+    ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint", "tool0_joint"];
+const TRIPLE: [[f64; 8]; 3] = [
+    [
+        2.3262656677907794,
+        0.6818684280582978,
+        2.39428789294752,
+        2.276771623960049,
+        1.4581508272089656,
+        1.2689149002932716,
+        0.01847976994306216,
+        -1.915057823936282,
+    ],
+    [
+        -2.636566638810667,
+        -0.5700379417947858,
+        1.5543806482359694,
+        1.5653099275652815,
+        -0.5548617135963831,
+        -2.789680498270184,
+        0.03316370801149869,
+        -1.8962443176668413,
+    ],
+    [
+        2.3489918091071202,
+        0.7010671794714393,
+        2.385904178256132,
+        2.285909494944286,
+        1.4359962858749236,
+        1.257838600196322,
+        0.01883300333765152,
+        -1.9291643109626693,
+    ],
+];
+
+fn triple(p: &mut Pipeline, i: usize, ms: i64) -> super::RobotState {
+    p.joint_state(&js(&TRIPLE_NAMES, &TRIPLE[i], ms * 1_000_000)).unwrap()
+}
+
+#[test]
+fn a_report_covers_every_state_since_the_last_one() {
+    let mut p = pipeline(Params::default());
+    assert!(p.params().check_motion, "motions are checked by default");
+    let a = triple(&mut p, 0, 0);
+    let first = p.check_path(std::slice::from_ref(&a)).unwrap();
+    assert_eq!((first.report.in_collision, first.report.motion), (false, false), "the first state is checked on its own");
+    // B and C arrive together: one report, stamped with C, covering A -> B -> C.
+    let b = triple(&mut p, 1, 10);
+    let c = triple(&mut p, 2, 20);
+    let r = p.check_path(&[b, c.clone()]).unwrap();
+    assert_eq!(r.stamp, c.stamp);
+    assert!(r.report.in_collision && r.report.motion && r.report.error.is_empty(), "{r:?}");
+    let f = r.report.fraction.unwrap();
+    assert!((0.0..0.5).contains(&f), "A -> B is the first of two steps and collides: {f}");
+    // C alone after A is free: what a node that dropped B would have reported.
+    let mut q = pipeline(Params::default());
+    let a = triple(&mut q, 0, 0);
+    let _ = q.check_path(&[a]);
+    let c = triple(&mut q, 2, 20);
+    let r = q.check_path(&[c]).unwrap();
+    assert_eq!((r.report.in_collision, r.report.motion, r.report.fraction), (false, true, None), "{r:?}");
+}
+
+#[test]
+fn the_trail_breaks_where_no_motion_is_known() {
+    let motion_into = |p: &mut Pipeline, i: usize, ms: i64| {
+        let s = triple(p, i, ms);
+        p.check_path(&[s]).unwrap().report.motion
+    };
+    let mut p = pipeline(Params::default());
+    assert!(!motion_into(&mut p, 0, 0), "first state");
+    assert!(motion_into(&mut p, 2, 100), "100 ms later");
+    assert!(!motion_into(&mut p, 0, 50), "a stamp going back");
+    assert!(!motion_into(&mut p, 2, 600), "550 ms later, past motion_max_gap");
+    assert!(motion_into(&mut p, 0, 1100), "500 ms later, at motion_max_gap");
+    assert!(p.joint_state(&js(&TRIPLE_NAMES[..1], &[f64::NAN], 1_150_000_000)).is_err());
+    assert!(!motion_into(&mut p, 2, 1200), "after a rejected message");
+    p.set_params(Params { motion_max_gap: 1.0, ..Params::default() }).unwrap();
+    assert!(!motion_into(&mut p, 0, 1300), "after new parameters");
+    assert!(motion_into(&mut p, 2, 2200), "900 ms later, within the new gap");
+}
+
+#[test]
+fn without_check_motion_the_newest_state_is_checked_and_older_ones_are_stale() {
+    let mut p = pipeline(Params { check_motion: false, ..Params::default() });
+    let states: Vec<_> = (0..3).map(|i| triple(&mut p, i, 10 * i as i64)).collect();
+    let r = p.check_path(&states).unwrap();
+    assert_eq!((r.report.in_collision, r.report.motion, r.stamp), (false, false, states[2].stamp), "only C is checked: {r:?}");
+    assert_eq!(p.skipped().get(&SkipCause::Stale), Some(&2));
+}

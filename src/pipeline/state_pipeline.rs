@@ -28,12 +28,23 @@ enum RobotSource {
     Description { urdf: Arc<str>, source: String },
 }
 
-/// A robot state ready to check: positions of every joint, or world poses of the links.
-#[derive(Clone, Debug, PartialEq)]
+/// A robot state ready to check: positions of every joint, or world poses of the links. Two
+/// states are equal when their stamps and poses are, however they were reached.
+#[derive(Clone, Debug)]
 pub struct RobotState {
     /// The input's stamp.
     pub stamp: Time,
     pose: StatePose,
+    /// Whether the robot got here from the state accepted just before (same robot and
+    /// parameters, no rejected message between, stamps forward by at most `motion_max_gap`): only
+    /// then is the motion between them checked.
+    follows: bool,
+}
+
+impl PartialEq for RobotState {
+    fn eq(&self, other: &RobotState) -> bool {
+        self.stamp == other.stamp && self.pose == other.pose
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -52,6 +63,10 @@ pub struct Pipeline {
     skipped: BTreeMap<SkipCause, u64>,
     unknown_names: HashSet<String>,
     warnings: Vec<String>,
+    /// Stamp of the last state accepted, while the next one may follow it.
+    last_stamp: Option<Time>,
+    /// The last state checked or covered by a report: where the next motion starts.
+    trail: Option<RobotState>,
 }
 
 impl Pipeline {
@@ -73,6 +88,8 @@ impl Pipeline {
             skipped: BTreeMap::new(),
             unknown_names: HashSet::new(),
             warnings: Vec::new(),
+            last_stamp: None,
+            trail: None,
         }
     }
 
@@ -105,7 +122,24 @@ impl Pipeline {
 
     fn skip(&mut self, cause: SkipCause, message: String) -> Skip {
         self.count_skip(cause, 1);
+        // A rejected state message breaks the trail: what the robot did in between is unknown,
+        // so the next state is checked on its own. Another robot's `/tf` says nothing of ours.
+        if cause != SkipCause::NotOurRobot {
+            self.last_stamp = None;
+        }
         Skip { cause, message }
+    }
+
+    /// A state made from an accepted message, marked as following the one before when a motion
+    /// between them may be checked.
+    fn accept(&mut self, stamp: Time, pose: StatePose) -> RobotState {
+        let max_gap = (self.params().motion_max_gap * 1e9) as i64;
+        let follows = self.last_stamp.is_some_and(|last| {
+            let gap = stamp.as_nanos() - last.as_nanos();
+            (0..=max_gap).contains(&gap)
+        });
+        self.last_stamp = Some(stamp);
+        RobotState { stamp, pose, follows }
     }
 
     /// A `sensor_msgs/JointState` from the stream: the state to check, or why there is none.
@@ -119,7 +153,7 @@ impl Pipeline {
             }
         }
         match result {
-            Ok(q) => Ok(RobotState { stamp: msg.header.stamp, pose: StatePose::Joints(q) }),
+            Ok(q) => Ok(self.accept(msg.header.stamp, StatePose::Joints(q))),
             Err(e) => {
                 let cause = match e {
                     StateError::Lengths { .. } => SkipCause::Lengths,
@@ -169,7 +203,7 @@ impl Pipeline {
             }
         }
         let stamp = msg.transforms.iter().map(|t| t.header.stamp).max().unwrap_or_default();
-        Ok(RobotState { stamp, pose: StatePose::Links(world_poses) })
+        Ok(self.accept(stamp, StatePose::Links(world_poses)))
     }
 
     /// Checks a state. A state the checker cannot take (it cannot happen for states this
@@ -182,15 +216,67 @@ impl Pipeline {
         CheckedState { stamp: state.stamp, report: result.unwrap_or_else(|e| StateReport::failed(e.to_string())) }
     }
 
-    /// Checks the motion from `from` to `to` (both joint states of the current robot): the
-    /// straight line in joint space, with nothing crossed unseen. A motion between link poses
-    /// (`/tf` input) is not checked yet and fails closed.
+    /// Checks the motion from `from` to `to`, with nothing crossed unseen: the straight line in
+    /// joint space between joint states; between link poses (`/tf`), each link along the straight
+    /// line and the shortest rotation between its two poses.
     pub fn check_motion(&self, from: &RobotState, to: &RobotState) -> CheckedState {
         let report = match (&from.pose, &to.pose) {
             (StatePose::Joints(a), StatePose::Joints(b)) => self.checker.check_motion(a, b).report,
-            _ => StateReport { motion: true, ..StateReport::failed("a motion between link poses (transforms) is not checked yet; check joint states") },
+            (StatePose::Links(a), StatePose::Links(b)) => self.checker.check_world_motion(a, b).report,
+            // Both ends come from one pose source; a mix cannot be interpolated.
+            _ => StateReport { motion: true, ..StateReport::failed("a motion between a joint state and link poses cannot be checked") },
         };
         CheckedState { stamp: to.stamp, report }
+    }
+
+    /// The states accepted since the last report, oldest first, as one report stamped with the
+    /// newest. With `check_motion`, the polyline through them from the last state reported: a
+    /// motion into every state that follows its predecessor, a discrete check of one that does
+    /// not (the first state, the first after a rejected message or a swap of robot or
+    /// parameters, a stamp that goes back or jumps past `motion_max_gap`); the first contact
+    /// along the polyline is reported, its `fraction` counting each state as an equal step
+    /// ((i + f) / n for step i of n). Without `check_motion`, the newest state alone, older
+    /// ones counted `stale`. `None` for no states.
+    pub fn check_path(&mut self, states: &[RobotState]) -> Option<CheckedState> {
+        let newest = states.last()?;
+        if !self.params().check_motion {
+            self.count_skip(SkipCause::Stale, states.len() as u64 - 1);
+            self.trail = Some(newest.clone());
+            return Some(self.check(newest));
+        }
+        let started = std::time::Instant::now();
+        let trail = self.trail.replace(newest.clone());
+        let steps = states.len() as f64;
+        let mut from = trail.as_ref();
+        let mut any_motion = false;
+        let mut last_report = None;
+        for (i, state) in states.iter().enumerate() {
+            let checked = match from.filter(|_| state.follows) {
+                Some(f) => {
+                    any_motion = true;
+                    self.check_motion(f, state)
+                }
+                None => self.check(state),
+            };
+            from = Some(state);
+            if checked.report.in_collision {
+                let mut report = checked.report;
+                if any_motion {
+                    // A discrete hit is where step i ends.
+                    let f = if report.motion { report.fraction.unwrap_or(0.0) } else { 1.0 };
+                    report.fraction = Some((i as f64 + f) / steps);
+                    report.motion = true;
+                }
+                report.check_seconds = started.elapsed().as_secs_f64();
+                return Some(CheckedState { stamp: newest.stamp, report });
+            }
+            last_report = Some(checked.report);
+        }
+        let mut report = last_report.unwrap_or_default();
+        report.motion = any_motion;
+        report.fraction = None;
+        report.check_seconds = started.elapsed().as_secs_f64();
+        Some(CheckedState { stamp: newest.stamp, report })
     }
 
     /// A `check_states` request: every state on its own, every name a joint of the robot; one
@@ -239,6 +325,10 @@ impl Pipeline {
             self.joints = JointInput::new(checker.robot());
         }
         self.checker = Arc::new(checker);
+        // The next state is checked on its own: the last one belongs to the old robot or
+        // parameters.
+        self.last_stamp = None;
+        self.trail = None;
     }
 
     /// The merged joint positions received so far, by joint index (`None`: none yet).

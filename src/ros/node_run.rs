@@ -167,8 +167,10 @@ impl Interfaces {
             move |e| anyhow!("publisher {name}: {e:?}")
         };
 
-        let js = topic(node, &names.joint_states, &namespace, "sensor_msgs", "JointState", &best_effort(1))?;
-        let states = node.create_subscription::<JointState>(&js, None).map_err(sub_err(&names.joint_states))?;
+        // 100 samples kept: states that arrive while one is checked are covered by the next
+        // report's motion (check_motion), not lost.
+        let js = topic(node, &names.joint_states, &namespace, "sensor_msgs", "JointState", &best_effort(STATES_KEPT))?;
+        let states = node.create_subscription::<JointState>(&js, Some(best_effort(STATES_KEPT))).map_err(sub_err(&names.joint_states))?;
         let desc_qos = latched(QosProfile::subscription_default(), 1);
         let desc = topic(node, &names.description, &namespace, "std_msgs", "String", &desc_qos)?;
         let descriptions = node.create_subscription::<DescriptionMsg>(&desc, Some(desc_qos.clone())).map_err(sub_err(&names.description))?;
@@ -306,6 +308,9 @@ impl TrajectoryWorker {
 /// flood cannot keep the loop from a stop request or the other inputs.
 const MAX_STATES_PER_TURN: usize = 256;
 
+/// Joint states the reader keeps while the node is busy.
+const STATES_KEPT: usize = 100;
+
 /// How long a stop request waits for the loop (busy building a robot, say) before the process
 /// exits without it: SIGTERM is honoured within 2 s whatever the loop is doing. (Exiting is not
 /// instant either: a process holding gigabytes took 0.6 s to be torn down.)
@@ -405,8 +410,8 @@ impl NodeState {
         }
     }
 
-    async fn publish_report(&mut self, io: &Interfaces, state: &RobotState) {
-        let checked = self.pipeline.check(state);
+    async fn publish_report(&mut self, io: &Interfaces, states: &[RobotState]) {
+        let Some(checked) = self.pipeline.check_path(states) else { return };
         self.stats.record_check(checked.report.check_seconds);
         let world = self.world();
         if io.collisions.async_publish(checked.message(&world)).await.is_err() {
@@ -424,8 +429,9 @@ impl NodeState {
     }
 
     /// Joint states: everything already waiting (up to [`MAX_STATES_PER_TURN`]) goes through the
-    /// pipeline in order (merging partial states), and the newest good state is checked; older
-    /// good ones are stale. A waiting sample that does not decode is counted and skipped.
+    /// pipeline in order (merging partial states), and one report covers the good ones (the
+    /// polyline through them with `check_motion`, else the newest, older ones stale). A waiting
+    /// sample that does not decode is counted and skipped.
     async fn on_joint_states(&mut self, io: &Interfaces, first: JointState) {
         let mut batch = vec![first];
         while batch.len() < MAX_STATES_PER_TURN {
@@ -436,27 +442,21 @@ impl NodeState {
             }
         }
         self.stats.received += batch.len() as u64;
-        let mut newest: Option<RobotState> = None;
+        let mut good = Vec::with_capacity(batch.len());
         for m in &batch {
             match self.pipeline.joint_state(m) {
-                Ok(state) => {
-                    if newest.replace(state).is_some() {
-                        self.pipeline.count_skip(SkipCause::Stale, 1);
-                    }
-                }
+                Ok(state) => good.push(state),
                 Err(skip) => self.warn_skip(&skip),
             }
         }
         self.warn_pending();
-        if let Some(state) = newest {
-            self.publish_report(io, &state).await;
-        }
+        self.publish_report(io, &good).await;
     }
 
     async fn on_tf(&mut self, io: &Interfaces, msg: TfMessage) {
         self.stats.received += 1;
         match self.pipeline.tf(&msg) {
-            Ok(state) => self.publish_report(io, &state).await,
+            Ok(state) => self.publish_report(io, std::slice::from_ref(&state)).await,
             Err(skip) => self.warn_skip(&skip),
         }
     }

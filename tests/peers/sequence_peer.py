@@ -9,7 +9,8 @@ A message: {"topic": "/joint_states" | "/tf" | "/tf_static", "t": log time ns, "
             "name": [...], "position": [... numbers or "NaN"]} or {..., "transforms":
             [{"parent", "child", "translation": [x,y,z], "rotation": [x,y,z,w]}]}.
 Live pacing: each message is sent after the previous one's report, or after 0.5 s for one that
-gets none. The first message must be a good state: it is sent again until a report comes back
+gets none; a message with "burst": true is followed by the next at once (faster than the node
+checks them). The first message must be a good state: it is sent again until a report comes back
 (the node may not have matched our writer yet); its duplicates are dropped.
 stdout (live): {"reports": [...], "diagnostics": {key: value}}; (bag): {"ok": true}.
 Loopback only: the caller sets CYCLONEDDS_URI (127.0.0.1, no multicast, peer 127.0.0.1).
@@ -81,7 +82,7 @@ def live(req):
         while time.time() < end:
             for r in reader.take(N=100):
                 got.append({"stamp": r.header.stamp.sec * 1_000_000_000 + r.header.stamp.nanosec, "frame_id": r.header.frame_id,
-                            "in_collision": bool(r.in_collision), "error": r.error,
+                            "in_collision": bool(r.in_collision), "error": r.error, "motion": bool(r.motion), "fraction": r.fraction,
                             "contacts": [{"link_name": c.link_name, "object_name": c.object_name, "triangle": int(c.triangle), "depth": c.depth}
                                          for c in r.contacts]})
             if got:
@@ -106,7 +107,8 @@ def live(req):
     collect(0.3)  # the warm-up's duplicates
     for m in rest:
         send(m)
-        reports.extend(collect(0.5))
+        if not m.get("burst"):
+            reports.extend(collect(0.5))
     time.sleep(1.5)  # a status after the last message
     drain_diag()
     return {"reports": reports, "diagnostics": diagnostics}
