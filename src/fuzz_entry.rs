@@ -163,9 +163,9 @@ fn workcell() -> &'static Pipeline {
 /// The workcell pipeline that `check --states` lines go through (it keeps the TF tree and merged
 /// joints between lines, as `check` does); rebuilt every [`LINES_PER_PIPELINE`] inputs so made-up
 /// frames never fill its TF tree for good.
-fn line_pipeline() -> &'static Mutex<(Pipeline, usize)> {
-    static LINES: OnceLock<Mutex<(Pipeline, usize)>> = OnceLock::new();
-    LINES.get_or_init(|| Mutex::new((fresh_workcell(), 0)))
+fn line_pipeline() -> &'static Mutex<(Pipeline, usize, Option<RobotState>)> {
+    static LINES: OnceLock<Mutex<(Pipeline, usize, Option<RobotState>)>> = OnceLock::new();
+    LINES.get_or_init(|| Mutex::new((fresh_workcell(), 0, None)))
 }
 
 const LINES_PER_PIPELINE: usize = 2_000;
@@ -273,12 +273,21 @@ pub fn mesh_dae(data: &[u8]) {
 pub fn cdr(data: &[u8]) {
     // The pipeline (a few milliseconds to build) only once a message decodes.
     let mut pipeline: Option<Pipeline> = None;
+    // The node checks the motion from each state to the next: so does this, on the workcell.
+    let mut previous: Option<RobotState> = None;
+    let mut motion_to = |state: RobotState| {
+        if let Some(from) = previous.as_ref() {
+            let _ = workcell().check_motion(from, &state);
+        }
+        previous = Some(state);
+    };
     for (kind, payload) in split_records(data) {
         match kind {
             CdrKind::JointStates => {
                 if let Ok(msg) = decode_cdr::<JointState>(payload) {
                     if let Ok(state) = pipeline.get_or_insert_with(fresh_pipeline).joint_state(&msg) {
                         check_on_workcell(&state);
+                        motion_to(state);
                     }
                 }
             }
@@ -286,6 +295,7 @@ pub fn cdr(data: &[u8]) {
                 if let Ok(msg) = decode_cdr::<TfMessage>(payload) {
                     if let Ok(state) = pipeline.get_or_insert_with(fresh_pipeline).tf(&msg) {
                         check_on_workcell(&state);
+                        motion_to(state);
                     }
                 }
             }
@@ -317,19 +327,27 @@ pub fn cdr(data: &[u8]) {
 }
 
 /// One `check --states` line: parsed, then checked by a fresh pipeline and by the workcell
-/// pipeline that keeps its state between lines (as `check` does).
+/// pipeline that keeps its state between lines (as `check` does), and as the next waypoint of a
+/// motion file (`check --states --motion`: the motion from the previous input's state to it).
 pub fn state_line(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else { return };
     let Ok(state) = parse_state_line(text) else { return };
     let _ = fresh_pipeline().check_line(state.clone());
     if let Ok(mut guard) = line_pipeline().lock() {
-        let (pipeline, uses) = &mut *guard;
+        let (pipeline, uses, previous) = &mut *guard;
         *uses += 1;
         if *uses > LINES_PER_PIPELINE {
             *pipeline = fresh_workcell();
             *uses = 1;
+            *previous = None;
         }
-        let _ = pipeline.check_line(state);
+        let _ = pipeline.check_line(state.clone());
+        if let (_, Ok(next)) = pipeline.line_state(state) {
+            if let Some(from) = previous.as_ref() {
+                let _ = pipeline.check_motion(from, &next);
+            }
+            *previous = Some(next);
+        }
         let _ = pipeline.take_warnings();
     }
 }
@@ -406,15 +424,19 @@ pub fn bag_sqlite(data: &[u8]) {
 }
 
 /// Points of a fuzzed trajectory checked against the workcell (all of them are validated, and
-/// checked against an empty environment): a segment of made-up positions can need the motion
-/// check's full 2^20 sub-intervals, seconds each.
+/// checked against an empty environment, where a segment costs one sub-interval).
 const TRAJECTORY_POINTS_ON_WORKCELL: usize = 4;
+
+/// Joint travel (radians or metres, summed over the joints and segments of those points) up to
+/// which the workcell walk is made: a segment of made-up positions (1e5 rad) needs the motion
+/// check's full 2^20 sub-intervals, 25 s, which would leave the fuzzer a handful of runs.
+const TRAJECTORY_TRAVEL_ON_WORKCELL: f64 = 20.0;
 
 /// A `check_trajectory` request: a CDR payload (with its 4-byte encapsulation header) decoded as
 /// the node decodes it, resolved against a fresh pipeline that has merged one partial joint state
 /// (so joints left out come from the current state, others from `missing_joint`), walked in full
 /// against an empty environment, and its first [`TRAJECTORY_POINTS_ON_WORKCELL`] points walked
-/// against the workcell.
+/// against the workcell when their joints travel at most [`TRAJECTORY_TRAVEL_ON_WORKCELL`].
 pub fn check_trajectory(data: &[u8]) {
     let Ok(request) = decode_cdr::<CheckTrajectoryRequest>(data) else { return };
     let mut pipeline = fresh_pipeline();
@@ -428,7 +450,10 @@ pub fn check_trajectory(data: &[u8]) {
     assert!(!answer.valid || (answer.segment == -1 && answer.error.is_empty()), "a valid answer with a segment or an error: {answer:?}");
     let mut head = request.trajectory;
     head.points.truncate(TRAJECTORY_POINTS_ON_WORKCELL);
-    let _ = workcell().check_trajectory(&head);
+    let travel: f64 = head.points.windows(2).map(|w| w[0].positions.iter().zip(&w[1].positions).map(|(a, b)| (b - a).abs()).sum::<f64>()).sum();
+    if travel <= TRAJECTORY_TRAVEL_ON_WORKCELL {
+        let _ = workcell().check_trajectory(&head);
+    }
 }
 
 /// Seed inputs for every target, generated from the bundled workcell and the library's own

@@ -30,6 +30,15 @@ use std::sync::Arc;
 /// Points a trajectory may have (the decoder refuses longer sequences already).
 pub const MAX_TRAJECTORY_POINTS: usize = MAX_TRAJECTORY_ENTRIES;
 
+/// Sub-intervals the motion checks of one request may examine in all (`MotionReport::subintervals`
+/// summed over its segments); the segments after the budget is spent are not checked and the
+/// request fails closed. One sub-interval costs some 25 µs on the bundled workcell, so this bounds a
+/// request to about 100 s of the worker's time (plus one segment, itself bounded by
+/// `checker::MAX_SUBINTERVALS`, 2^20): without it 65,535 segments of 1,000 rad each, about 1 s
+/// apiece, would hold the worker for 18 hours. A planner's trajectory of 36,000 free segments in
+/// `tests/ros_trajectory.rs` spends some 250,000.
+pub const MAX_TRAJECTORY_SUBINTERVALS: u64 = 1 << 22;
+
 /// Names a trajectory may give (more than any robot has joints; the decoder refuses longer lists
 /// already).
 pub const MAX_TRAJECTORY_NAMES: usize = MAX_TRAJECTORY_ENTRIES;
@@ -179,8 +188,13 @@ impl TrajectoryJob {
     }
 
     /// Walks the segments in order with the motion check; the first that is not free ends the
-    /// walk. A single point is checked as one state.
+    /// walk, and so does a spent [`MAX_TRAJECTORY_SUBINTERVALS`] budget (failing closed at the
+    /// first segment not checked). A single point is checked as one state.
     pub fn run(&self) -> CheckTrajectoryResponse {
+        self.run_with_budget(MAX_TRAJECTORY_SUBINTERVALS)
+    }
+
+    fn run_with_budget(&self, budget: u64) -> CheckTrajectoryResponse {
         let plan = match &self.plan {
             Ok(plan) => plan,
             Err(e) => return refused(e.clone()),
@@ -205,8 +219,14 @@ impl TrajectoryJob {
             }
             return free();
         }
+        let mut spent = 0u64;
         for (i, pair) in plan.q.windows(2).enumerate() {
+            if spent >= budget {
+                let error = format!("the motion checks spent the {budget} sub-intervals one request may use; segments {i} to {} not checked", plan.q.len() - 2);
+                return answer(i, StateReport::failed(error), -1.0, DurationMsg::default());
+            }
             let r = self.checker.check_motion(&pair[0], &pair[1]);
+            spent += r.subintervals;
             if !r.report.in_collision {
                 continue;
             }
@@ -318,6 +338,23 @@ mod tests {
         let one = trajectory(&names, vec![point(&[1.2, 0.3], 4, 5)]);
         let r = p.check_trajectory(&one);
         assert_eq!((r.valid, r.segment, r.fraction, r.time_from_start), (false, 0, 0.0, DurationMsg { sec: 4, nanosec: 5 }));
+    }
+
+    #[test]
+    fn a_spent_budget_fails_closed_at_the_first_segment_not_checked() {
+        let p = arm(MissingJoint::Last);
+        let names = ["shoulder_lift_joint", "elbow_joint"];
+        let t = trajectory(&names, (0..6).map(|k| point(&[0.0, 0.1 * (k % 2) as f64], k, 0)).collect());
+        let job = p.trajectory_job(&t);
+        let free = job.run();
+        assert!(free.valid, "{free:?}");
+        // What each segment costs, and a budget spent after the second.
+        let q = &job.plan.as_ref().unwrap().q;
+        let cost: Vec<u64> = q.windows(2).map(|w| p.checker().check_motion(&w[0], &w[1]).subintervals).collect();
+        let r = job.run_with_budget(cost[0] + cost[1]);
+        assert_eq!((r.valid, r.segment, r.fraction), (false, 2, -1.0), "{r:?}");
+        assert!(r.error.starts_with("segment 2: ") && r.error.contains("segments 2 to 4 not checked"), "{}", r.error);
+        assert_eq!(job.run_with_budget(cost.iter().sum::<u64>()), free, "the whole budget checks everything");
     }
 
     #[test]
