@@ -181,6 +181,9 @@ fn tf_bags_replay_like_check_with_transforms() {
         lines.push(json!({"transforms": line, "stamp": T0 + k as i64 * 10_000_000}).to_string());
     }
     let reference = check_reference(&d, &lines);
+    // Motions between link poses: each link along the straight line and the shortest rotation.
+    let motion_reference = check_reference_with(&d, &lines, &["--motion"]);
+    assert_eq!(motion_reference.iter().filter(|l| l.contains("\"motion\":true")).count(), 119, "every message after the first is a motion");
     for storage in ["mcap", "sqlite3"] {
         let bag = d.join(format!("tf_{storage}"));
         write_bag(&bag, storage, &msgs, None);
@@ -188,6 +191,10 @@ fn tf_bags_replay_like_check_with_transforms() {
         let _ = ok(replay(&bag, &["--pose-source", "tf", "--jsonl", jsonl.to_str().unwrap()]));
         let got: Vec<String> = std::fs::read_to_string(&jsonl).unwrap().lines().map(str::to_owned).collect();
         same_lines(&got, &reference, storage);
+        let moving = d.join(format!("tf_motion_{storage}.jsonl"));
+        let _ = ok(replay(&bag, &["--pose-source", "tf", "--motion", "--jsonl", moving.to_str().unwrap()]));
+        let got: Vec<String> = std::fs::read_to_string(&moving).unwrap().lines().map(str::to_owned).collect();
+        same_lines(&got, &motion_reference, &format!("{storage}: replay --motion vs check --motion, /tf"));
     }
 }
 
