@@ -29,8 +29,9 @@ pub const MAX_SUBINTERVALS: u64 = 1 << 20;
 
 /// Rungs of the growth ladder per doubling: growth `base · 2^(level / RUNGS)`. The growth used is
 /// the first rung at or above the bound, so it overshoots by up to `2^(1/RUNGS)`; a grown link
-/// that overshoots touches more and splits more often.
-const RUNGS: usize = 2;
+/// that overshoots touches more and splits more often. On the motion benchmark (2,000 motions)
+/// 1, 2 and 4 rungs took 158, 135 and 125 link tests per motion.
+const RUNGS: usize = 4;
 
 /// Levels of the growth ladder: from `base` (half the tolerance) to far past any accepted size.
 const LEVELS: usize = 64 * RUNGS;
@@ -43,7 +44,8 @@ pub struct MotionReport {
     /// The start of the first sub-interval that could not be cleared, in [0, 1]; `None` when free
     /// or not checked.
     pub fraction: Option<f64>,
-    /// Sub-intervals examined.
+    /// Sub-intervals examined, counted once for each link tested on one (the count
+    /// `MAX_SUBINTERVALS` bounds).
     pub subintervals: u64,
 }
 

@@ -10,6 +10,13 @@ use crate::collision::{CollideSettings, Target, TargetShape};
 use crate::math::{Pose, Real};
 use std::collections::hash_map::{Entry, HashMap};
 
+/// Growth above which a sub-interval is split without being tested (metres): it only saves work.
+/// On the motion benchmark (Panda, 1M cells, 2,000 motions) links grown by more than 0.36 m were
+/// free in 92 of 35,000 tests, and a test that hits cost ~50 µs there; splitting instead of
+/// testing above 0.15 m took the mean time per motion from 15.4 to 11.3 state checks (14 % more
+/// link tests, each cheaper).
+const MAX_TESTED_GROWTH: Real = 0.15;
+
 /// A motion as the adaptive loop sees it.
 pub(super) trait MotionPath {
     /// Per target (as `Checker::targets`): a bound on how far any point of it moves per unit of
@@ -79,14 +86,17 @@ impl Checker {
                 };
                 // A link that does not move is where it is at every s: checked as it is, ungrown
                 // (a base resting on a table is not a near miss).
-                let (level, covered) = if speed[ti] > 0.0 {
+                // Tested only when the growth covers the bound (rounding, NaN or past the ladder's
+                // top: split) and is not beyond what is worth testing (the first rung always is).
+                let (level, tested) = if speed[ti] > 0.0 {
                     let delta = path.bound(ti, poses, 0.5 * (b - a));
                     let level = bounds.level(delta);
-                    (Some(level), bounds.growth(level) >= delta)
+                    let growth = bounds.growth(level);
+                    (Some(level), growth >= delta && (growth <= MAX_TESTED_GROWTH || level == 0))
                 } else {
                     (None, true)
                 };
-                if covered && !self.grown_link_hit(ti, level, &link_pose, &flags) {
+                if tested && !self.grown_link_hit(ti, level, &link_pose, &flags) {
                     continue;
                 }
                 if level.is_none_or(|l| l == 0) {
