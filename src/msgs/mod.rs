@@ -7,6 +7,7 @@
 //! order, and the replay tests read what `replay` writes back with rosbags.
 
 mod definitions;
+pub mod moveit;
 
 pub use self::definitions::{full_definition, COLLISION_REPORT_TYPE};
 

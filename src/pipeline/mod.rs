@@ -15,12 +15,14 @@ mod state_line;
 mod state_pipeline;
 mod tf_tree;
 mod trajectory;
+mod validity;
 
 pub use self::report_adapter::{report_message, CheckedState};
 pub use self::skip::{Skip, SkipCause};
 pub use self::state_line::{parse_state_line, LinkTransform, StateLine};
 pub use self::state_pipeline::{Pipeline, RobotState};
 pub use self::trajectory::{TrajectoryJob, MAX_TRAJECTORY_NAMES, MAX_TRAJECTORY_POINTS, MAX_TRAJECTORY_SUBINTERVALS};
+pub use self::validity::ValidityJob;
 
 #[cfg(test)]
 mod pipeline_tests;

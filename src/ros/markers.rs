@@ -79,6 +79,9 @@ pub struct NodeStats {
     pub window_checks: u64,
     /// Received count at the last status.
     pub last_received: u64,
+    /// `check_state_validity` requests answered `valid = false` without a check (refused, busy,
+    /// or the check failed) since start.
+    pub validity_refused: u64,
 }
 
 impl NodeStats {
@@ -125,6 +128,7 @@ pub fn diagnostics(
         values.push(kv(&format!("skipped_{}", cause.key()), skipped.get(&cause).copied().unwrap_or(0).to_string()));
     }
     values.push(kv("robot_description_error", description_error.unwrap_or_default().to_owned()));
+    values.push(kv("check_state_validity_refused", stats.validity_refused.to_string()));
     let counts = format!("{rate:.1} states/s, {total} skipped ({bad} bad or foreign)");
     let (level, message) = match description_error {
         Some(e) => (ERROR, e.to_owned()),

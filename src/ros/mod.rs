@@ -10,6 +10,7 @@ mod msg_impls;
 mod node_run;
 mod param_values;
 mod ros_args;
+mod validity_worker;
 
 pub use self::node_run::{run, RunOptions};
 pub use self::ros_args::{parse_ros_args, RosArgs};

@@ -9,8 +9,10 @@ use super::markers::{cell_markers, contact_markers, diagnostics, NodeStats};
 use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
 use super::param_values::{declarations, to_json, READ_ONLY};
 use super::ros_args::RosArgs;
+use super::validity_worker::{ValidityWorker, MAX_VALIDITY_PENDING};
 use crate::limits::MAX_DESCRIPTION_BYTES;
 use crate::model::{Params, PoseSource, ServiceMapping};
+use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
 use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause, TrajectoryJob};
 use anyhow::{anyhow, Context as _, Result};
@@ -119,6 +121,7 @@ struct Interfaces {
     diagnostics: ros2_client::Publisher<DiagnosticArray>,
     check_states: ros2_client::Server<CheckStatesRequest, CheckStatesResponse>,
     check_trajectory: ros2_client::Server<CheckTrajectoryRequest, CheckTrajectoryResponse>,
+    check_state_validity: ros2_client::Server<GetStateValidityRequest, GetStateValidityResponse>,
     names: Names,
 }
 
@@ -128,6 +131,7 @@ struct Names {
     collisions: String,
     check_states: String,
     check_trajectory: String,
+    check_state_validity: String,
     description: String,
     cells: String,
     contacts: String,
@@ -150,6 +154,7 @@ impl Interfaces {
             collisions: resolve(remaps, "collisions"),
             check_states: resolve(remaps, "check_states"),
             check_trajectory: resolve(remaps, "check_trajectory"),
+            check_state_validity: resolve(remaps, "check_state_validity"),
             description: resolve(remaps, "robot_description"),
             cells: resolve(remaps, "collision_markers/cells"),
             contacts: resolve(remaps, "collision_markers/contacts"),
@@ -224,7 +229,31 @@ impl Interfaces {
                 reliable(100),
             )
             .map_err(|e| anyhow!("service {}: {e:?}", names.check_trajectory))?;
-        Ok(Interfaces { states, tf, descriptions, clock, collisions, cells, contacts, diagnostics, check_states, check_trajectory, names })
+        // MoveIt's service type, so a planner calls it unchanged (remap to /check_state_validity
+        // to take move_group's name; never with move_group serving it too).
+        let check_state_validity = node
+            .create_server::<GetStateValidityRequest, GetStateValidityResponse>(
+                mapping,
+                &ros_name(&names.check_state_validity, &namespace)?,
+                &ServiceTypeName::new("moveit_msgs", "GetStateValidity"),
+                reliable(100),
+                reliable(100),
+            )
+            .map_err(|e| anyhow!("service {}: {e:?}", names.check_state_validity))?;
+        Ok(Interfaces {
+            states,
+            tf,
+            descriptions,
+            clock,
+            collisions,
+            cells,
+            contacts,
+            diagnostics,
+            check_states,
+            check_trajectory,
+            check_state_validity,
+            names,
+        })
     }
 }
 
@@ -263,6 +292,9 @@ enum Event {
     TrajectoryRequest(ros2_client::service::RmwRequestId, CheckTrajectoryRequest),
     /// The worker checked a trajectory: the answer to send.
     TrajectoryDone(ros2_client::service::RmwRequestId, CheckTrajectoryResponse),
+    ValidityRequest(ros2_client::service::RmwRequestId, GetStateValidityRequest),
+    /// The worker checked a state: the answer to send, and why the request was not honoured.
+    ValidityDone(ros2_client::service::RmwRequestId, GetStateValidityResponse, Option<String>),
     /// A sample that could not be read (on the topic or service named).
     ReadFailed(&'static str, ReadError),
     Tick,
@@ -544,6 +576,45 @@ impl NodeState {
         }
     }
 
+    /// A `check_state_validity` request: resolved by the pipeline here (cheap), checked by the
+    /// worker. A refused request is answered at once, as is one past [`MAX_VALIDITY_PENDING`].
+    async fn on_validity_request(&mut self, io: &Interfaces, worker: &ValidityWorker, id: ros2_client::service::RmwRequestId, req: GetStateValidityRequest) {
+        let job = self.pipeline.validity_job(&req);
+        drop(req);
+        if let Some(w) = job.warning() {
+            let w = w.to_owned();
+            self.log.warn("service-validity-group", || format!("{}: {w}", io.names.check_state_validity));
+        }
+        if let Some(reason) = job.refused() {
+            let reason = reason.to_owned();
+            return self.send_validity_answer(io, id, GetStateValidityResponse::default(), Some(reason)).await;
+        }
+        let reason = match worker.jobs.try_send((id, job)) {
+            Ok(()) => return,
+            Err(std::sync::mpsc::TrySendError::Full(_)) => format!("busy: {MAX_VALIDITY_PENDING} check_state_validity requests are waiting"),
+            Err(std::sync::mpsc::TrySendError::Disconnected(_)) => "the check_state_validity worker has stopped".to_owned(),
+        };
+        self.send_validity_answer(io, id, GetStateValidityResponse::default(), Some(reason)).await;
+    }
+
+    /// Sends an answer; a request not honoured is logged (console and `/rosout`) and counted for
+    /// `/diagnostics`, as the response has no text field.
+    async fn send_validity_answer(
+        &mut self,
+        io: &Interfaces,
+        id: ros2_client::service::RmwRequestId,
+        answer: GetStateValidityResponse,
+        reason: Option<String>,
+    ) {
+        if let Some(reason) = reason {
+            self.stats.validity_refused += 1;
+            self.log.warn("service-validity", || format!("{}: request not honoured (valid = false): {reason}", io.names.check_state_validity));
+        }
+        if io.check_state_validity.async_send_response(id, answer).await.is_err() {
+            self.log.warn("service-send", || format!("sending a {} response failed", io.names.check_state_validity));
+        }
+    }
+
     fn on_tick(&mut self, node: &Node, io: &Interfaces) {
         // Warnings go to /rosout too (the console already has them).
         for text in self.log.pending.drain(..) {
@@ -600,8 +671,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
             PoseSource::JointStates => format!("{} (sensor_msgs/msg/JointState)", io.names.joint_states),
         };
         println!(
-            "  subscribes {input}, publishes {} (thickness_collision_msgs/msg/CollisionReport), serves {} and {}",
-            io.names.collisions, io.names.check_states, io.names.check_trajectory
+            "  subscribes {input}, publishes {} (thickness_collision_msgs/msg/CollisionReport), serves {}, {} and {} (moveit_msgs/srv/GetStateValidity)",
+            io.names.collisions, io.names.check_states, io.names.check_trajectory, io.names.check_state_validity
         );
     }
 
@@ -631,6 +702,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         .context("cannot install the Ctrl-C/SIGTERM handler")?;
     }
     let worker = TrajectoryWorker::start()?;
+    let validity_worker = ValidityWorker::start()?;
     let spinner = node.spinner().map_err(|e| anyhow!("spinner: {e:?}"))?;
     let fqn = node.fully_qualified_name();
     let mut state = NodeState {
@@ -664,6 +736,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let mut requests = io.check_states.receive_request_stream();
         let mut trajectories = io.check_trajectory.receive_request_stream();
         let mut checked_trajectories = Box::pin(worker.done.clone());
+        let mut validity_requests = io.check_state_validity.receive_request_stream();
+        let mut checked_validity = Box::pin(validity_worker.done.clone());
         while !stop.load(Ordering::SeqCst) {
             state.on_tick(&node, &io);
             let tick = FutureExt::fuse(smol::Timer::after(Duration::from_millis(100)));
@@ -677,6 +751,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 r = requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_states", e), |(id, req)| Event::Request(id, req)),
                 r = trajectories.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_trajectory", e), |(id, req)| Event::TrajectoryRequest(id, req)),
                 (id, answer) = checked_trajectories.select_next_some() => Event::TrajectoryDone(id, answer),
+                r = validity_requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_state_validity", e), |(id, req)| Event::ValidityRequest(id, req)),
+                (id, answer, reason) = checked_validity.select_next_some() => Event::ValidityDone(id, answer, reason),
                 _ = tick => Event::Tick,
             };
             // A parameter change accepted before this input arrived applies to it.
@@ -690,6 +766,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 Event::Request(id, req) => state.on_request(&io, id, req).await,
                 Event::TrajectoryRequest(id, req) => state.on_trajectory_request(&io, &worker, id, req).await,
                 Event::TrajectoryDone(id, answer) => state.send_trajectory_answer(&io, id, answer).await,
+                Event::ValidityRequest(id, req) => state.on_validity_request(&io, &validity_worker, id, req).await,
+                Event::ValidityDone(id, answer, reason) => state.send_validity_answer(&io, id, answer, reason).await,
                 Event::ReadFailed(what, e) => state.on_read_failed(what, &e),
                 Event::Tick => {}
             }
