@@ -1,0 +1,81 @@
+"""coal 3.0.3 with MoveIt-style motion sampling, the peer of benches/motion.rs: each motion is
+checked at a fixed number of discrete states (201: steps of 0.005 of the motion, as MoveIt's
+`longest_valid_segment_fraction` 0.005), in order, stopping at the first colliding state; a
+state is checked part by part (each link part a coal.Convex hull against one BVH model, OBBRSS,
+of all the world's triangles, as in benches/peer_compare.py), stopping at the first colliding
+part.
+
+Usage: coal_motion.py DIR   (DIR holds meta.json and the raw arrays written by benches/motion.rs)
+Writes DIR/coal_motion.json: per motion 0/1 (a sampled state collides), the seconds spent in
+collide calls (the Python loop and call overhead measured and taken off), and the collide calls.
+"""
+import json
+import sys
+import time
+from pathlib import Path
+
+import coal
+import numpy as np
+
+d = Path(sys.argv[1])
+meta = json.loads((d / "meta.json").read_text())
+M, S, P = meta["motions"], meta["samples"], meta["parts"]
+V = np.fromfile(d / "env_vertices.f64", dtype="<f8").reshape(-1, 3)
+T = np.fromfile(d / "env_triangles.u32", dtype="<u4").reshape(-1, 3).astype(np.int64)
+poses = np.fromfile(d / "motion_poses.f64", dtype="<f8").reshape(M, S, P, 12)
+
+env = coal.BVHModelOBBRSS()
+env.beginModel(len(T), len(V))
+env.addVertices(V)
+env.addTriangles(T)
+env.endModel()
+shapes = []
+for i in range(P):
+    pv = np.fromfile(d / f"part{i}_vertices.f64", dtype="<f8").reshape(-1, 3)
+    pt = np.fromfile(d / f"part{i}_triangles.u32", dtype="<u4").reshape(-1, 3)
+    tris = coal.StdVec_Triangle()
+    for a, b, c in pt:
+        tris.append(coal.Triangle(int(a), int(b), int(c)))
+    verts = coal.StdVec_Vec3s()
+    for v in pv:
+        verts.append(np.asarray(v, dtype=float))
+    shapes.append(coal.Convex(verts, tris))
+
+I = coal.Transform3s()
+req = coal.CollisionRequest()
+res = coal.CollisionResult()
+hits, seconds, overhead, calls = [], 0.0, 0.0, 0
+for m in range(M):
+    # Transforms built outside the timed loop (MoveIt's FK is not coal's time either).
+    tfs = [[coal.Transform3s(poses[m, s, p, :9].reshape(3, 3).copy(), poses[m, s, p, 9:].copy()) for p in range(P)] for s in range(S)]
+    hit = False
+    n = 0
+    t0 = time.perf_counter()
+    for s in range(S):
+        for p in range(P):
+            res.clear()
+            coal.collide(env, I, shapes[p], tfs[s][p], req, res)
+            n += 1
+            if res.isCollision():
+                hit = True
+                break
+        if hit:
+            break
+    seconds += time.perf_counter() - t0
+    # The same loop and calls without collide, for the overhead.
+    t0 = time.perf_counter()
+    k = 0
+    for s in range(S):
+        for p in range(P):
+            res.clear()
+            tfs[s][p].isIdentity()  # stands in for the call dispatch of collide
+            k += 1
+            if k == n:
+                break
+        if k == n:
+            break
+    overhead += time.perf_counter() - t0
+    calls += n
+    hits.append(1 if hit else 0)
+out = {"hits": hits, "seconds": seconds - overhead, "overhead_seconds": overhead, "calls": calls}
+(d / "coal_motion.json").write_text(json.dumps(out))
