@@ -11,6 +11,7 @@ fn msg_and_srv_files_parse_with_rosbags() {
     for name in [
         "thickness_collision_msgs/msg/Contact",
         "thickness_collision_msgs/msg/CollisionReport",
+        "thickness_collision_msgs/msg/Clearance",
         "thickness_collision_msgs/srv/CheckStates_Request",
         "thickness_collision_msgs/srv/CheckStates_Response",
         "thickness_collision_msgs/srv/CheckTrajectory_Request",
@@ -27,7 +28,32 @@ fn msg_and_srv_files_parse_with_rosbags() {
     assert_eq!(fields, ["link_name", "object_name", "triangle", "depth", "position", "normal"]);
     let report = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/interfaces/thickness_collision_msgs/msg/CollisionReport.msg")).unwrap();
     let fields: Vec<&str> = report.lines().filter_map(|l| l.split('#').next()).filter_map(|l| l.split_whitespace().nth(1)).collect();
-    assert_eq!(fields, ["header", "in_collision", "contacts", "check_seconds", "error", "motion", "fraction"]);
+    assert_eq!(fields, ["header", "in_collision", "contacts", "check_seconds", "error", "motion", "fraction", "clearances"]);
+    let r = serde_json::to_value(thickness_collision::msgs::CollisionReport::default()).unwrap();
+    assert_eq!(r.as_object().unwrap().len(), fields.len());
+    assert!(r["clearances"].is_array());
+    let clearance = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/interfaces/thickness_collision_msgs/msg/Clearance.msg")).unwrap();
+    let lines: Vec<(&str, &str)> =
+        clearance.lines().filter_map(|l| l.split('#').next()).filter_map(|l| Some((l.split_whitespace().next()?, l.split_whitespace().nth(1)?))).collect();
+    assert_eq!(
+        lines,
+        [
+            ("string", "link_name"),
+            ("string", "object_name"),
+            ("uint32", "triangle"),
+            ("float64", "distance"),
+            ("geometry_msgs/Point", "point_on_link"),
+            ("geometry_msgs/Point", "point_on_object")
+        ]
+    );
+    // serde_json sorts keys: compare the names as sets (the wire order is the struct's, checked
+    // by the round trip through the peer's types in the bag tests).
+    let c = serde_json::to_value(thickness_collision::msgs::ClearanceMsg::default()).unwrap();
+    let mut keys: Vec<&str> = c.as_object().unwrap().keys().map(String::as_str).collect();
+    let mut names: Vec<&str> = lines.iter().map(|(_, n)| *n).collect();
+    keys.sort_unstable();
+    names.sort_unstable();
+    assert_eq!(keys, names);
     let c = thickness_collision::msgs::ContactMsg::default();
     let v = serde_json::to_value(&c).unwrap();
     let keys: Vec<&String> = v.as_object().unwrap().keys().collect();

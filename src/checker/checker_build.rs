@@ -439,6 +439,10 @@ impl Checker {
                     }
                 }
             }
+            if !settings.flag_only {
+                let threshold = self.params.clearance_threshold;
+                report.clearances.extend(super::clearance::link_clearance(&self.scene, &self.allowed[ti], lt, link_pose, best.as_ref(), threshold));
+            }
             if let Some(c) = best {
                 report.contacts.push(ReportContact {
                     link_name: lt.name.clone(),

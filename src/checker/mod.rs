@@ -4,6 +4,7 @@
 //! collision reports.
 
 mod checker_build;
+mod clearance;
 mod joint_state;
 mod motion;
 mod motion_sweep;
@@ -13,4 +14,4 @@ mod world_motion;
 pub use self::checker_build::{BuildSummary, Checker, CheckerError, LinkTargets};
 pub use self::joint_state::StateError;
 pub use self::motion::{MotionReport, MAX_SUBINTERVALS};
-pub use self::state_report::{ReportContact, StateReport};
+pub use self::state_report::{ReportClearance, ReportContact, StateReport};

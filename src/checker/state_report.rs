@@ -19,6 +19,24 @@ pub struct ReportContact {
     pub normal: [f64; 3],
 }
 
+/// How near one link is to the environment, as in `thickness_collision_msgs/Clearance`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReportClearance {
+    /// Robot link.
+    pub link_name: String,
+    /// The nearest environment object (link of the environment URDF).
+    pub object_name: String,
+    /// Triangle index of the nearest cell in the object's mesh file (`u32::MAX` for solids).
+    pub triangle: u32,
+    /// Signed distance (metres): the gap to the nearest cell or solid, or minus the depth of the
+    /// link's contact when it collides.
+    pub distance: f64,
+    /// The nearest point on the link (world frame); the contact point when colliding.
+    pub point_on_link: [f64; 3],
+    /// The nearest point on the object (world frame); the contact point when colliding.
+    pub point_on_object: [f64; 3],
+}
+
 /// The result for one state, as in `thickness_collision_msgs/CollisionReport` (without header).
 ///
 /// Fail closed: a state that could not be checked is reported with `in_collision` set and the
@@ -42,6 +60,10 @@ pub struct StateReport {
     /// stretch that could not be cleared, never later than the true first contact).
     #[serde(default)]
     pub fraction: Option<f64>,
+    /// Each checked link within `clearance_threshold` of the environment, in link order; empty
+    /// when clearance is off.
+    #[serde(default)]
+    pub clearances: Vec<ReportClearance>,
     /// Seconds spent checking (not part of `check --json`, which must be deterministic).
     #[serde(skip)]
     pub check_seconds: f64,

@@ -23,10 +23,12 @@ mod polytope;
 mod report;
 mod sat;
 mod scene;
+mod scene_clearance;
 mod target;
 
 pub use self::cell_contact::{collide_target_cell, CellHit};
 pub use self::cell_tree::CellTree;
 pub use self::report::{CollideSettings, Contact, LeastOverlap, TargetReport};
 pub use self::scene::{ObjectBody, Scene, SceneObject};
+pub use self::scene_clearance::Clearance;
 pub use self::target::{ConvexHull, Target, TargetShape};

@@ -47,6 +47,11 @@ impl SceneObject {
         }
     }
 
+    /// Its bounding box in the world.
+    pub(crate) fn world_aabb(&self) -> &Aabb {
+        &self.world_aabb
+    }
+
     /// Bytes of the broad-phase tree (for memory reports); 0 for solids.
     pub fn bvh_memory(&self) -> usize {
         match &self.body {

@@ -135,6 +135,9 @@ pub struct Params {
     pub check_motion: bool,
     /// Stamps further apart than this (seconds) are checked as separate states, not as a motion.
     pub motion_max_gap: f64,
+    /// Every report lists each checked link within this distance (metres) of the environment,
+    /// with its distance and nearest points; 0 turns clearance off.
+    pub clearance_threshold: f64,
 }
 
 impl Default for Params {
@@ -163,12 +166,17 @@ impl Default for Params {
             motion_tolerance: 0.001,
             check_motion: true,
             motion_max_gap: 0.5,
+            clearance_threshold: 0.0,
         }
     }
 }
 
 /// Longest `motion_max_gap` (s): an hour between two states is no motion anyone recorded.
 const MAX_MOTION_GAP: f64 = 3600.0;
+
+/// Largest `clearance_threshold` (m): clearance is a local question (a planner's margin), and a
+/// threshold of metres would make every report measure most of the environment.
+const MAX_CLEARANCE: f64 = 10.0;
 
 /// Marker rates outside this range (Hz) are refused: below it a period overflows a `Duration`
 /// long before anyone would wait for it, above it the markers would cost more than the checks.
@@ -267,6 +275,9 @@ impl Params {
         }
         if !(0.0..=MAX_MOTION_GAP).contains(&self.motion_max_gap) {
             return bad("motion_max_gap", format!("must be from 0 to {MAX_MOTION_GAP} s, got {}", crate::limits::show_number(self.motion_max_gap)));
+        }
+        if !(0.0..=MAX_CLEARANCE).contains(&self.clearance_threshold) {
+            return bad("clearance_threshold", format!("must be from 0 (off) to {MAX_CLEARANCE} m, got {}", crate::limits::show_number(self.clearance_threshold)));
         }
         if let Some(p) = self.padding.values.iter().find(|p| !(**p >= 0.0 && **p <= hi)) {
             return bad("padding.values", format!("must be from 0 to {hi:e} m, got {p:?}"));
@@ -514,6 +525,18 @@ mod tests {
         }
         for (n, v) in &flat {
             assert_eq!(Params::default().with_value(n, v.clone()).unwrap(), Params::default(), "{n}");
+        }
+    }
+
+    #[test]
+    fn clearance_threshold_is_off_by_default_and_validated() {
+        let p = Params::default();
+        assert_eq!(p.clearance_threshold, 0.0, "off unless asked for");
+        let q = p.with_overrides(&[("clearance_threshold".into(), "0.05".into())]).unwrap();
+        assert_eq!(q.clearance_threshold, 0.05);
+        for v in ["-0.01", "11", ".nan", ".inf"] {
+            let e = p.with_overrides(&[("clearance_threshold".into(), v.into())]).unwrap_err().to_string();
+            assert!(e.contains("clearance_threshold") && e.contains("must be from 0 (off) to 10 m") && !e.contains('\n'), "clearance_threshold:={v}: {e}");
         }
     }
 

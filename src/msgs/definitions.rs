@@ -7,6 +7,7 @@ pub const COLLISION_REPORT_TYPE: &str = "thickness_collision_msgs/msg/CollisionR
 const SEPARATOR: &str = "================================================================================";
 
 const CONTACT: &str = include_str!("../../interfaces/thickness_collision_msgs/msg/Contact.msg");
+const CLEARANCE: &str = include_str!("../../interfaces/thickness_collision_msgs/msg/Clearance.msg");
 const COLLISION_REPORT: &str = include_str!("../../interfaces/thickness_collision_msgs/msg/CollisionReport.msg");
 const HEADER: &str = "# Standard metadata for higher-level stamped data types.\nbuiltin_interfaces/Time stamp\nstring frame_id\n";
 const TIME: &str = "int32 sec\nuint32 nanosec\n";
@@ -24,6 +25,7 @@ pub fn full_definition(type_name: &str) -> Option<String> {
                 ("thickness_collision_msgs/Contact", CONTACT),
                 ("geometry_msgs/Point", POINT),
                 ("geometry_msgs/Vector3", VECTOR3),
+                ("thickness_collision_msgs/Clearance", CLEARANCE),
             ],
         ),
         _ => return None,

@@ -193,7 +193,27 @@ pub struct CollisionReport {
     pub motion: bool,
     /// The first contact along the motion in [0, 1] when `motion` and `in_collision`; else -1.
     pub fraction: f64,
+    /// Each checked link within `clearance_threshold` of the environment (empty when off).
+    pub clearances: Vec<ClearanceMsg>,
 }
+
+/// `thickness_collision_msgs/msg/Clearance`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ClearanceMsg {
+    /// Robot link.
+    pub link_name: String,
+    /// The nearest environment object.
+    pub object_name: String,
+    /// Triangle of the nearest cell in the object's mesh file (4294967295 for solids).
+    pub triangle: u32,
+    /// Signed distance (metres); minus the depth of the link's contact when colliding.
+    pub distance: f64,
+    /// Nearest point on the link; the contact point when colliding.
+    pub point_on_link: Point,
+    /// Nearest point on the object; the contact point when colliding.
+    pub point_on_object: Point,
+}
+
 
 /// `std_msgs/msg/ColorRGBA`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]

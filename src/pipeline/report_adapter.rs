@@ -2,8 +2,8 @@
 //! output bag) and the JSON object (`check --json`, replay's `--jsonl`). One conversion each, so
 //! every door writes the same fields.
 
-use crate::checker::{ReportContact, StateReport};
-use crate::msgs::{CollisionReport, ContactMsg, Header, Time, Vector3};
+use crate::checker::{ReportClearance, ReportContact, StateReport};
+use crate::msgs::{ClearanceMsg, CollisionReport, ContactMsg, Header, Point, Time, Vector3};
 use serde::Serialize;
 
 /// A report with the stamp of the input it answers.
@@ -57,5 +57,19 @@ pub fn report_message(report: &StateReport, stamp: Time, frame: &str) -> Collisi
         error: report.error.clone(),
         motion: report.motion,
         fraction: report.fraction.filter(|_| report.motion && report.in_collision).unwrap_or(-1.0),
+        clearances: report.clearances.iter().map(clearance_message).collect(),
+    }
+}
+
+/// The `Clearance` message of one link's clearance.
+fn clearance_message(c: &ReportClearance) -> ClearanceMsg {
+    let p = |a: [f64; 3]| Point { x: a[0], y: a[1], z: a[2] };
+    ClearanceMsg {
+        link_name: c.link_name.clone(),
+        object_name: c.object_name.clone(),
+        triangle: c.triangle,
+        distance: c.distance,
+        point_on_link: p(c.point_on_link),
+        point_on_object: p(c.point_on_object),
     }
 }

@@ -18,7 +18,7 @@ IFACE = ROOT / "interfaces" / "thickness_collision_msgs"
 def typestore_with_project_types():
     store = get_typestore(Stores.ROS2_JAZZY)
     types = {}
-    for name in ["Contact", "CollisionReport"]:
+    for name in ["Contact", "Clearance", "CollisionReport"]:
         types.update(get_types_from_msg((IFACE / "msg" / f"{name}.msg").read_text(), f"thickness_collision_msgs/msg/{name}"))
     store.register(types)
     return store

@@ -53,6 +53,7 @@ def from_msg(pkg, kind, name, text, local):
 IFACE = ROOT / "interfaces" / "thickness_collision_msgs"
 local = {}
 local["Contact"] = from_msg("thickness_collision_msgs", "msg", "Contact", (IFACE / "msg/Contact.msg").read_text(), local)
+local["Clearance"] = from_msg("thickness_collision_msgs", "msg", "Clearance", (IFACE / "msg/Clearance.msg").read_text(), local)
 local["CollisionReport"] = from_msg("thickness_collision_msgs", "msg", "CollisionReport", (IFACE / "msg/CollisionReport.msg").read_text(), local)
 CollisionReport = local["CollisionReport"]
 req_text, resp_text = (IFACE / "srv/CheckStates.srv").read_text().split("---")

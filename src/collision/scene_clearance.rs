@@ -1,0 +1,173 @@
+//! Clearance: the distance from a target to the nearest cell or solid within a threshold.
+//!
+//! The same cell tree that bounds depth per node bounds distance: a node's box is at least as far
+//! from the target as the target's bounding box (in the surface's frame) and its bounding ball
+//! are, and a subtree whose lower bound is not below the nearest distance found so far (at first
+//! the threshold) is pruned. Children are visited nearer bound first, so the first leaves reached
+//! usually settle the answer. Each cell (and each solid) that survives its own box bound gets an
+//! exact distance from GJK (parry's, in f64, with this crate's hill-climbing support for hulls),
+//! which stops as soon as it proves the pair farther apart than the best so far.
+
+use super::cell_tree::TargetView;
+use super::scene::{ObjectBody, Scene};
+use super::target::{Target, TargetShape};
+use crate::math::{Aabb, Pose, Real, Vector};
+use parry3d_f64::bounding_volume::BoundingVolume;
+use parry3d_f64::query::gjk::{GJKResult, VoronoiSimplex};
+use parry3d_f64::shape::SupportMap;
+
+/// The nearest cell or solid to a target, in the world frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clearance {
+    /// Index of the object in the scene.
+    pub object: usize,
+    /// Input index of the triangle whose cell is nearest (`u32::MAX` for solids).
+    pub triangle: u32,
+    /// Distance between the two shapes (metres, at least 0: a query for clearance does not
+    /// measure overlap; a colliding target reports its contact instead).
+    pub distance: Real,
+    /// The nearest point on the target.
+    pub point1: Vector,
+    /// The nearest point on the object.
+    pub point2: Vector,
+}
+
+/// A target shape as parry's GJK sees it (hulls climb their own vertex graph).
+struct ShapeSupport<'a>(&'a TargetShape);
+
+impl SupportMap for ShapeSupport<'_> {
+    fn local_support_point(&self, dir: Vector) -> Vector {
+        let unit = |v: Vector| v.try_normalize().unwrap_or(Vector::ZERO);
+        match self.0 {
+            TargetShape::Polytope(h) => h.support_point(dir),
+            TargetShape::Sphere { radius } => unit(dir) * *radius,
+            TargetShape::Capsule { half_height, radius } => Vector::new(0.0, 0.0, half_height.copysign(dir.z)) + unit(dir) * *radius,
+            TargetShape::Cylinder { half_height, radius } => {
+                let xy = unit(Vector::new(dir.x, dir.y, 0.0)) * *radius;
+                Vector::new(xy.x, xy.y, half_height.copysign(dir.z))
+            }
+        }
+    }
+}
+
+/// A cell's six vertices (caps collapsed to a point repeat it).
+struct CellSupport([Vector; 6]);
+
+impl SupportMap for CellSupport {
+    fn local_support_point(&self, dir: Vector) -> Vector {
+        let mut best = self.0[0];
+        let mut d = dir.dot(best);
+        for p in &self.0[1..] {
+            let x = dir.dot(*p);
+            if x > d {
+                (best, d) = (*p, x);
+            }
+        }
+        best
+    }
+}
+
+/// Distance between two boxes given by centre and half extents (0 when they meet).
+#[inline]
+fn box_box_distance(c1: Vector, h1: Vector, c2: Vector, h2: Vector) -> Real {
+    ((c1 - c2).abs() - h1 - h2).max(Vector::ZERO).length()
+}
+
+/// A lower bound on the distance from the target (its box `aabb` and its ball `centre`,
+/// `radius`, in the surface's frame) to anything inside the box `(c, h)`.
+#[inline]
+fn lower_bound(aabb: &Aabb, centre: Vector, radius: Real, c: Vector, h: Vector) -> Real {
+    let by_box = box_box_distance(aabb.center(), aabb.half_extents(), c, h);
+    let by_ball = ((centre - c).abs() - h).max(Vector::ZERO).length() - radius;
+    by_box.max(by_ball)
+}
+
+/// Exact distance and nearest points (both in frame 1) of two support maps, or `None` when they
+/// are farther apart than `max_dist`.
+fn gjk_distance<G1: SupportMap, G2: SupportMap>(pos12: &Pose, g1: &G1, g2: &G2, max_dist: Real) -> Option<(Real, Vector, Vector)> {
+    let mut simplex = VoronoiSimplex::new();
+    match parry3d_f64::query::details::contact_support_map_support_map_with_params(pos12, g1, g2, max_dist, &mut simplex, None) {
+        // `n` points from shape 1 to shape 2: the signed distance is the witnesses' gap along it,
+        // and an overlap (EPA's answer) counts as touching here (see `Clearance::distance`).
+        GJKResult::ClosestPoints(p1, p2, n) => Some(((p2 - p1).dot(n).max(0.0), p1, p2)),
+        _ => None,
+    }
+}
+
+impl Scene {
+    /// The nearest cell or solid, among the objects for which `check(object index)` is true, at a
+    /// distance of at most `threshold` from the target; `None` when nothing is that close. Meant
+    /// for targets that do not collide (a colliding one may report any distance near 0).
+    pub fn clearance_filtered(&self, target: &Target, threshold: Real, check: impl Fn(usize) -> bool) -> Option<Clearance> {
+        if !(threshold > 0.0) {
+            return None;
+        }
+        let mut best: Option<Clearance> = None;
+        let mut best_dist = threshold;
+        let target_aabb = target.aabb_in(&target.pose);
+        let support1 = ShapeSupport(&target.shape);
+        let radius = target.shape.bounding_radius();
+        for (oi, object) in self.objects().iter().enumerate() {
+            if !check(oi) || !object.world_aabb().loosened(best_dist).intersects(&target_aabb) {
+                continue;
+            }
+            let pose = object.pose;
+            let (area, tree) = match &object.body {
+                ObjectBody::Surface { area, tree } => (area, tree),
+                ObjectBody::Solid(shape) => {
+                    let target_in_object = pose.inv_mul(&target.pose);
+                    if !target.aabb_in(&target_in_object).loosened(best_dist).intersects(&shape.local_aabb()) {
+                        continue;
+                    }
+                    let pos12 = target.pose.inv_mul(&pose);
+                    if let Some((d, p1, p2)) = gjk_distance(&pos12, &support1, &ShapeSupport(shape), best_dist) {
+                        if d <= best_dist {
+                            best_dist = d;
+                            best = Some(Clearance { object: oi, triangle: u32::MAX, distance: d, point1: target.pose * p1, point2: target.pose * p2 });
+                        }
+                    }
+                    continue;
+                }
+            };
+            if tree.is_empty() {
+                continue;
+            }
+            let view = TargetView::new(target, &pose, area.side, &target_aabb);
+            let bound = |c: Vector, h: Vector| lower_bound(&view.aabb, view.centre, radius, c, h);
+            let (c, h) = tree.node_box(0);
+            let mut stack: Vec<(Real, u32)> = vec![(bound(c, h), 0)];
+            while let Some((lb, node)) = stack.pop() {
+                if lb > best_dist {
+                    continue;
+                }
+                if let Some(children) = tree.children(node) {
+                    let mut next = children.map(|child| {
+                        let (c, h) = tree.node_box(child);
+                        (bound(c, h), child)
+                    });
+                    // The nearer child on top of the stack.
+                    if next[0].0 < next[1].0 {
+                        next.swap(0, 1);
+                    }
+                    stack.extend(next.into_iter().filter(|(b, _)| *b <= best_dist));
+                    continue;
+                }
+                for (index, slab) in tree.leaf_cells(node) {
+                    if bound(slab.centre(), slab.half()) > best_dist {
+                        continue;
+                    }
+                    let cell = &area.cells[index as usize];
+                    let cell_support = CellSupport(cell.vertices());
+                    if let Some((d, p1, p2)) = gjk_distance(&view.object_in_target, &support1, &cell_support, best_dist) {
+                        if d <= best_dist {
+                            best_dist = d;
+                            best = Some(Clearance { object: oi, triangle: cell.triangle, distance: d, point1: target.pose * p1, point2: target.pose * p2 });
+                        }
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+

@@ -1,0 +1,123 @@
+//! Clearance (`clearance_threshold`) against an independent computation: the Panda (from
+//! example-robot-data) in the peer benchmark's 10,000-triangle world, random joint states (fixed
+//! seed) drawn until 2,000 of them have a link within the threshold. For every state and every
+//! checked link, parry3d-f64's `query::distance` from the link's hull to every cell whose box
+//! comes within the threshold of the link's box (a brute-force scan over all cells, each cell its
+//! own `ConvexPolyhedron`: neither this crate's cell tree nor its support functions) gives the
+//! oracle distance. Then:
+//! - a link the oracle puts within the threshold (by more than 1e-5 m) is reported, and nothing
+//!   beyond it (by more than 1e-5 m) is;
+//! - a reported distance is within 1e-5 m of the oracle's, its two points are that far apart, the
+//!   point on the object lies in the reported triangle's cell and the point on the link on the hull
+//!   (1e-6 m);
+//! - a colliding link reports minus its contact's depth, both points at the contact point.
+
+#[path = "../benches/peer_compare_core.rs"]
+mod peer_compare_core;
+
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
+use parry3d_f64::query::PointQuery;
+use parry3d_f64::shape::{ConvexPolyhedron, Shape};
+use peer_compare_core::*;
+use thickness_collision::checker::Checker;
+use thickness_collision::collision::TargetShape;
+use thickness_collision::math::{Pose, Real, Vector};
+use thickness_collision::model::Params;
+
+const THRESHOLD: Real = 0.05;
+const TOLERANCE: Real = 1e-5;
+
+#[test]
+fn reported_clearances_match_parry_distance_to_every_cell_within_the_threshold() {
+    let py = python();
+    let (robot, map) = panda(&py);
+    let w = world(10_000);
+    let params = Params { package_map: map.clone(), clearance_threshold: THRESHOLD, ..Params::default() };
+    let checker = Checker::from_robot_and_scene(params, robot.clone(), w.scene, "panda".into()).unwrap();
+    // Every cell of every surface once, in the world, as a parry polyhedron with its world box.
+    let mut cells: Vec<(usize, u32, ConvexPolyhedron, Aabb)> = Vec::new();
+    for (oi, object) in checker.scene().objects().iter().enumerate() {
+        for cell in &object.area().expect("the peer world has thin surfaces only").cells {
+            let pts: Vec<Vector> = cell.distinct_vertices().iter().map(|v| object.pose * *v).collect();
+            let poly = ConvexPolyhedron::from_convex_hull(&pts).expect("a cell is a solid polyhedron");
+            let aabb = poly.local_aabb();
+            cells.push((oi, cell.triangle, poly, aabb));
+        }
+    }
+    let (mut near_states, mut checked_states) = (0, 0);
+    let (mut reported, mut colliding, mut worst) = (0usize, 0usize, 0.0 as Real);
+    let mut seed = 7;
+    while near_states < 2_000 {
+        let states = random_states(&robot, 500, seed);
+        seed += 1;
+        for (names, pos) in &states {
+            checked_states += 1;
+            let report = checker.check_joints(names, pos).unwrap();
+            if !report.clearances.is_empty() {
+                near_states += 1;
+            }
+            let mut q = vec![0.0; robot.joints.len()];
+            for (n, p) in names.iter().zip(pos) {
+                q[robot.joint(n).unwrap()] = *p;
+            }
+            let links = robot.forward_kinematics(&q, &nalgebra::Isometry3::identity()).unwrap();
+            for t in checker.targets() {
+                let link_pose = thickness_collision::math::pose_from_isometry(&links[t.link]);
+                let mine = report.clearances.iter().find(|c| c.link_name == t.name);
+                // Its environment contact (a self-collision contact names a robot link instead).
+                let contact = report.contacts.iter().find(|c| c.link_name == t.name && checker.scene().objects().iter().any(|o| o.name == c.object_name));
+                if let Some(contact) = contact {
+                    let c = mine.unwrap_or_else(|| panic!("state {pos:?}: colliding link {} has no clearance", t.name));
+                    let p = contact.position.unwrap();
+                    assert!(c.distance == -contact.depth && c.point_on_link == p && c.point_on_object == p, "{c:?} against {contact:?}");
+                    assert_eq!((c.object_name.as_str(), c.triangle), (contact.object_name.as_str(), contact.triangle));
+                    colliding += 1;
+                    continue;
+                }
+                // The oracle: parry's distance from each part's hull to each cell near it.
+                let mut oracle = Real::INFINITY;
+                for (shape, offset) in &t.parts {
+                    let TargetShape::Polytope(hull) = shape else { panic!("Panda links are hulls") };
+                    let pose = link_pose * *offset;
+                    let part_box = hull.as_parry().compute_aabb(&pose).loosened(THRESHOLD);
+                    for (_, _, poly, aabb) in &cells {
+                        if part_box.intersects(aabb) {
+                            let d = parry3d_f64::query::distance(&pose, hull.as_parry(), &Pose::IDENTITY, poly).unwrap().distance;
+                            oracle = oracle.min(d);
+                        }
+                    }
+                }
+                match mine {
+                    None => assert!(oracle > THRESHOLD - TOLERANCE, "state {pos:?}: link {} is {oracle} m from a cell but not reported", t.name),
+                    Some(c) => {
+                        reported += 1;
+                        assert!(c.distance <= THRESHOLD, "{c:?} beyond the threshold");
+                        let error = (c.distance - oracle).abs();
+                        worst = worst.max(error);
+                        assert!(error <= TOLERANCE, "state {pos:?}: link {}: reported {} m, parry {oracle} m", t.name, c.distance);
+                        let (a, b) = (Vector::from_array(c.point_on_link), Vector::from_array(c.point_on_object));
+                        assert!(((a - b).length() - c.distance).abs() <= TOLERANCE, "{c:?}: the points are {} m apart", (a - b).length());
+                        // The point on the object lies in the named cell.
+                        let object = checker.scene().objects().iter().find(|o| o.name == c.object_name).unwrap();
+                        let cell = object.area().unwrap().cells.iter().find(|cell| cell.triangle == c.triangle).unwrap();
+                        assert!(cell.contains_point(object.pose.inverse() * b, 1e-6), "{c:?}: the point on the object is not in its cell");
+                        // The point on the link lies on one of its hulls.
+                        let on_link = t
+                            .parts
+                            .iter()
+                            .map(|(shape, offset)| {
+                                let TargetShape::Polytope(hull) = shape else { unreachable!() };
+                                hull.as_parry().distance_to_point(&(link_pose * *offset), a, true)
+                            })
+                            .fold(Real::INFINITY, Real::min);
+                        assert!(on_link <= 1e-6, "{c:?}: the point on the link is {on_link} m from it");
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{checked_states} states, {near_states} with a link within {THRESHOLD} m: {reported} link clearances within {worst:e} m of parry's, {colliding} colliding links"
+    );
+    assert!(reported > 2_000 && colliding > 0, "both kinds exercised");
+}
