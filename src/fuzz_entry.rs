@@ -47,6 +47,7 @@ pub const TARGETS: &[(&str, Entry)] = &[
     ("bag_mcap", bag_mcap),
     ("bag_sqlite", bag_sqlite),
     ("check_trajectory", check_trajectory),
+    ("check_state_validity", check_state_validity),
 ];
 
 /// Printed before a panic the library contained (mesh-loader), once per message.
@@ -463,6 +464,35 @@ pub fn check_trajectory(data: &[u8]) {
     }
 }
 
+/// What every `check_state_validity` answer must be: refused (a reason) means not valid and no
+/// contacts; otherwise valid exactly when there are no contacts; never cost sources or
+/// constraint results.
+fn assert_validity_answer(answer: &crate::msgs::moveit::GetStateValidityResponse, reason: Option<&str>) {
+    assert!(answer.cost_sources.is_empty() && answer.constraint_result.is_empty(), "cost sources or constraint results: {answer:?}");
+    match reason {
+        Some(r) => assert!(!answer.valid && answer.contacts.is_empty() && !r.is_empty() && !r.contains('\n'), "refused ({r}) but {answer:?}"),
+        None => assert_eq!(answer.valid, answer.contacts.is_empty(), "valid with contacts, or not valid without: {answer:?}"),
+    }
+}
+
+/// A `check_state_validity` request (`moveit_msgs/srv/GetStateValidity`): a CDR payload (with its
+/// 4-byte encapsulation header) decoded as the node decodes it, resolved against a fresh pipeline
+/// that has merged one partial joint state (joints left out from the merged state or
+/// `missing_joint`) and checked against an empty environment, then against the workcell; the
+/// answers' invariants asserted.
+pub fn check_state_validity(data: &[u8]) {
+    let Ok(request) = decode_cdr::<crate::msgs::moveit::GetStateValidityRequest>(data) else { return };
+    let mut pipeline = fresh_pipeline();
+    let first = pipeline.checker().robot().joints.iter().find(|j| j.is_actuated()).map(|j| j.name.clone());
+    if let Some(name) = first {
+        let _ = pipeline.joint_state(&JointState { name: vec![name], position: vec![0.25], ..Default::default() });
+    }
+    let (answer, reason) = pipeline.check_validity(&request);
+    assert_validity_answer(&answer, reason.as_deref());
+    let (answer, reason) = workcell().check_validity(&request);
+    assert_validity_answer(&answer, reason.as_deref());
+}
+
 /// Seed inputs for every target, generated from the bundled workcell and the library's own
 /// encoders: (target, file name, bytes). `tests/fuzz_regressions.rs` writes them to
 /// `fuzz/corpus/<target>/` (`scripts/fuzz_campaign.sh` asks it to); the bag seeds, written by
@@ -615,6 +645,40 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
         }
     }
 
+    // State validity requests: every joint (free), into a guard, a partial state, an unknown group,
+    // and refused ones (an attached object, constraints, a multi-DOF joint, NaN, an unknown joint).
+    {
+        use crate::msgs::moveit::{AttachedCollisionObject, GetStateValidityRequest, JointConstraint, RobotStateMsg};
+        let request = |name: Vec<String>, position: Vec<f64>| GetStateValidityRequest {
+            robot_state: RobotStateMsg { joint_state: JointState { header: header("world"), name, position, ..Default::default() }, ..Default::default() },
+            ..Default::default()
+        };
+        let lift_elbow = vec!["shoulder_lift_joint".to_string(), "elbow_joint".to_string()];
+        let mut group = request(lift_elbow.clone(), vec![1.2, 0.3]);
+        group.group_name = "arm".into();
+        let mut attached = request(lift_elbow.clone(), vec![0.0, 0.0]);
+        attached.robot_state.attached_collision_objects.push(AttachedCollisionObject { link_name: "tool0".into(), ..Default::default() });
+        let mut constrained = request(lift_elbow.clone(), vec![0.0, 0.0]);
+        constrained.constraints.joint_constraints.push(JointConstraint { joint_name: "elbow_joint".into(), ..Default::default() });
+        let mut multi = request(vec![], vec![]);
+        multi.robot_state.multi_dof_joint_state.joint_names.push("virtual_joint".into());
+        multi.robot_state.multi_dof_joint_state.transforms.push(Transform::default());
+        let requests = [
+            ("every_joint", request(names.clone(), vec![0.0; names.len()])),
+            ("into_guard", request(lift_elbow.clone(), vec![1.2, 0.3])),
+            ("partial", request(vec!["elbow_joint".into()], vec![0.4])),
+            ("group", group),
+            ("attached", attached),
+            ("constraints", constrained),
+            ("multi_dof", multi),
+            ("nan", request(lift_elbow.clone(), vec![0.0, f64::NAN])),
+            ("unknown_joint", request(vec!["no_such_joint".into()], vec![0.0])),
+        ];
+        for (name, r) in requests {
+            out.push(("check_state_validity", format!("{name}.cdr"), encode_cdr_le(&r)));
+        }
+    }
+
     // Parameters: the bundled file and the defaults written out.
     let params = std::fs::read(crate::model::bundled_config_dir().join("params.yaml")).unwrap_or_default();
     out.push(("params_yaml", "params.yaml".into(), params));
@@ -641,6 +705,23 @@ mod tests {
             seen += 1;
         }
         assert_eq!(seen, 7);
+    }
+
+    #[test]
+    fn validity_seeds_decode_and_reach_the_check() {
+        let mut seen = 0;
+        for (_, name, bytes) in seeds().into_iter().filter(|s| s.0 == "check_state_validity") {
+            let request = decode_cdr::<crate::msgs::moveit::GetStateValidityRequest>(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let (a, reason) = workcell().check_validity(&request);
+            assert_validity_answer(&a, reason.as_deref());
+            match name.as_str() {
+                "every_joint.cdr" | "partial.cdr" => assert!(reason.is_none(), "{name}: {reason:?}"),
+                "into_guard.cdr" | "group.cdr" => assert!(!a.valid && reason.is_none() && !a.contacts.is_empty(), "{name}: {a:?}"),
+                _ => assert!(reason.is_some(), "{name}: {a:?}"),
+            }
+            seen += 1;
+        }
+        assert_eq!(seen, 9);
     }
 
     #[test]
