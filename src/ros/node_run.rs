@@ -292,7 +292,8 @@ enum Event {
     TrajectoryRequest(ros2_client::service::RmwRequestId, CheckTrajectoryRequest),
     /// The worker checked a trajectory: the answer to send.
     TrajectoryDone(ros2_client::service::RmwRequestId, CheckTrajectoryResponse),
-    ValidityRequest(ros2_client::service::RmwRequestId, GetStateValidityRequest),
+    /// Boxed: a request holds some 450 bytes inline, the other events a fraction of that.
+    ValidityRequest(ros2_client::service::RmwRequestId, Box<GetStateValidityRequest>),
     /// The worker checked a state: the answer to send, and why the request was not honoured.
     ValidityDone(ros2_client::service::RmwRequestId, GetStateValidityResponse, Option<String>),
     /// A sample that could not be read (on the topic or service named).
@@ -578,7 +579,7 @@ impl NodeState {
 
     /// A `check_state_validity` request: resolved by the pipeline here (cheap), checked by the
     /// worker. A refused request is answered at once, as is one past [`MAX_VALIDITY_PENDING`].
-    async fn on_validity_request(&mut self, io: &Interfaces, worker: &ValidityWorker, id: ros2_client::service::RmwRequestId, req: GetStateValidityRequest) {
+    async fn on_validity_request(&mut self, io: &Interfaces, worker: &ValidityWorker, id: ros2_client::service::RmwRequestId, req: Box<GetStateValidityRequest>) {
         let job = self.pipeline.validity_job(&req);
         drop(req);
         if let Some(w) = job.warning() {
@@ -751,7 +752,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 r = requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_states", e), |(id, req)| Event::Request(id, req)),
                 r = trajectories.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_trajectory", e), |(id, req)| Event::TrajectoryRequest(id, req)),
                 (id, answer) = checked_trajectories.select_next_some() => Event::TrajectoryDone(id, answer),
-                r = validity_requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_state_validity", e), |(id, req)| Event::ValidityRequest(id, req)),
+                r = validity_requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_state_validity", e), |(id, req)| Event::ValidityRequest(id, Box::new(req))),
                 (id, answer, reason) = checked_validity.select_next_some() => Event::ValidityDone(id, answer, reason),
                 _ = tick => Event::Tick,
             };
