@@ -579,7 +579,13 @@ impl NodeState {
 
     /// A `check_state_validity` request: resolved by the pipeline here (cheap), checked by the
     /// worker. A refused request is answered at once, as is one past [`MAX_VALIDITY_PENDING`].
-    async fn on_validity_request(&mut self, io: &Interfaces, worker: &ValidityWorker, id: ros2_client::service::RmwRequestId, req: Box<GetStateValidityRequest>) {
+    async fn on_validity_request(
+        &mut self,
+        io: &Interfaces,
+        worker: &ValidityWorker,
+        id: ros2_client::service::RmwRequestId,
+        req: Box<GetStateValidityRequest>,
+    ) {
         let job = self.pipeline.validity_job(&req);
         drop(req);
         if let Some(w) = job.warning() {
