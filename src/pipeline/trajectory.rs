@@ -308,13 +308,34 @@ mod tests {
         assert_eq!(job.plan.as_ref().unwrap().q[1][lift], 0.0);
     }
 
+    const PAN_LIFT_ELBOW: [&str; 3] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"];
+
+    /// Two nearby poses (pan, lift, elbow; the other joints at 0) whose motion is free both ways,
+    /// found on a small grid so that the tests do not hang on one pose staying free.
+    fn free_pair(p: &Pipeline) -> ([f64; 3], [f64; 3]) {
+        let grid = [0.0, 0.5, -0.5, 1.0, -1.0, 1.5, 2.0, 3.0];
+        for pan in grid {
+            for lift in [-0.3, 0.0, -0.6, 0.3] {
+                for elbow in [0.6, 0.3, 1.0, -0.5] {
+                    let (a, b) = ([pan, lift, elbow], [pan + 0.1, lift + 0.1, elbow + 0.1]);
+                    let t = trajectory(&PAN_LIFT_ELBOW, vec![point(&a, 0, 0), point(&b, 1, 0), point(&a, 2, 0)]);
+                    if p.check_trajectory(&t).valid {
+                        return (a, b);
+                    }
+                }
+            }
+        }
+        panic!("no free pair of poses on the grid");
+    }
+
     #[test]
     fn the_answer_is_the_first_motion_check_that_fails() {
         let p = arm(MissingJoint::Last);
         let c = p.checker();
-        let names = ["shoulder_lift_joint", "elbow_joint"];
+        let names = PAN_LIFT_ELBOW;
         // Free, then free, then into the guard (as in the motion check's own test).
-        let t = trajectory(&names, vec![point(&[0.0, 0.0], 1, 0), point(&[0.1, 0.1], 2, 0), point(&[0.2, 0.1], 3, 0), point(&[1.2, 0.3], 5, 0)]);
+        let (a, b) = free_pair(&p);
+        let t = trajectory(&names, vec![point(&a, 1, 0), point(&b, 2, 0), point(&a, 3, 0), point(&[0.0, 1.2, 0.3], 5, 0)]);
         let r = p.check_trajectory(&t);
         let job = p.trajectory_job(&t);
         let q = &job.plan.as_ref().unwrap().q;
@@ -335,7 +356,7 @@ mod tests {
         let r = p.check_trajectory(&free_part);
         assert_eq!((r.valid, r.segment, r.fraction, r.error.as_str()), (true, -1, -1.0, ""));
         // One point: a state; in collision at segment 0, fraction 0, its own time.
-        let one = trajectory(&names, vec![point(&[1.2, 0.3], 4, 5)]);
+        let one = trajectory(&names, vec![point(&[0.0, 1.2, 0.3], 4, 5)]);
         let r = p.check_trajectory(&one);
         assert_eq!((r.valid, r.segment, r.fraction, r.time_from_start), (false, 0, 0.0, DurationMsg { sec: 4, nanosec: 5 }));
     }
@@ -343,8 +364,8 @@ mod tests {
     #[test]
     fn a_spent_budget_fails_closed_at_the_first_segment_not_checked() {
         let p = arm(MissingJoint::Last);
-        let names = ["shoulder_lift_joint", "elbow_joint"];
-        let t = trajectory(&names, (0..6).map(|k| point(&[0.0, 0.1 * (k % 2) as f64], k, 0)).collect());
+        let (a, b) = free_pair(&p);
+        let t = trajectory(&PAN_LIFT_ELBOW, (0..6).map(|k| point(if k % 2 == 0 { &a } else { &b }, k, 0)).collect());
         let job = p.trajectory_job(&t);
         let free = job.run();
         assert!(free.valid, "{free:?}");
