@@ -121,3 +121,58 @@ fn reported_clearances_match_parry_distance_to_every_cell_within_the_threshold()
     );
     assert!(reported > 2_000 && colliding > 0, "both kinds exercised");
 }
+
+/// The field in `check --json` (and replay's JSON lines) and in the `CollisionReport` message:
+/// `clearances` is an empty array when the threshold is 0, and with it each entry carries the
+/// report's values under the message's field names.
+#[test]
+fn clearances_reach_the_json_and_the_message() {
+    use thickness_collision::msgs::Time;
+    use thickness_collision::pipeline::{report_message, CheckedState};
+    let py = python();
+    let (robot, map) = panda(&py);
+    let off =
+        Checker::from_robot_and_scene(Params { package_map: map.clone(), ..Params::default() }, robot.clone(), world(2_000).scene, "panda".into()).unwrap();
+    let on = Checker::from_robot_and_scene(
+        Params { package_map: map, clearance_threshold: THRESHOLD, ..Params::default() },
+        robot.clone(),
+        world(2_000).scene,
+        "panda".into(),
+    )
+    .unwrap();
+    let states = random_states(&robot, 400, 3);
+    let mut seen = 0;
+    for (names, pos) in &states {
+        let report = off.check_joints(names, pos).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&CheckedState { stamp: Time::default(), report: report.clone() }.json()).unwrap();
+        assert_eq!(json["clearances"], serde_json::json!([]), "off: an empty array");
+        assert!(report_message(&report, Time::default(), "world").clearances.is_empty());
+        let report = on.check_joints(names, pos).unwrap();
+        if report.clearances.is_empty() {
+            continue;
+        }
+        seen += 1;
+        let json: serde_json::Value = serde_json::from_str(&CheckedState { stamp: Time::default(), report: report.clone() }.json()).unwrap();
+        let message = report_message(&report, Time::default(), "world");
+        let listed = json["clearances"].as_array().unwrap();
+        assert_eq!((listed.len(), message.clearances.len()), (report.clearances.len(), report.clearances.len()));
+        for ((c, j), m) in report.clearances.iter().zip(listed).zip(&message.clearances) {
+            let mut keys: Vec<&str> = j.as_object().unwrap().keys().map(String::as_str).collect();
+            keys.sort_unstable();
+            assert_eq!(keys, ["distance", "link_name", "object_name", "point_on_link", "point_on_object", "triangle"]);
+            assert_eq!(j["link_name"], c.link_name.as_str());
+            assert_eq!(j["object_name"], c.object_name.as_str());
+            assert_eq!(j["triangle"], c.triangle);
+            assert_eq!(j["distance"].as_f64().unwrap(), c.distance);
+            assert_eq!(j["point_on_link"], serde_json::json!(c.point_on_link));
+            assert_eq!(j["point_on_object"], serde_json::json!(c.point_on_object));
+            assert_eq!(
+                (m.link_name.as_str(), m.object_name.as_str(), m.triangle, m.distance),
+                (c.link_name.as_str(), c.object_name.as_str(), c.triangle, c.distance)
+            );
+            assert_eq!([m.point_on_link.x, m.point_on_link.y, m.point_on_link.z], c.point_on_link);
+            assert_eq!([m.point_on_object.x, m.point_on_object.y, m.point_on_object.z], c.point_on_object);
+        }
+    }
+    assert!(seen > 20, "{seen} states with a clearance");
+}

@@ -108,7 +108,11 @@ impl Checker {
             }
         }
         match blocked {
-            None => MotionReport { report: StateReport { motion: true, ..Default::default() }, fraction: None, subintervals: examined },
+            None => {
+                // A free motion stands for its end pose: the clearances are that pose's.
+                let clearances = if self.params().clearance_threshold > 0.0 { path.report_at(1.0).clearances } else { Vec::new() };
+                MotionReport { report: StateReport { motion: true, clearances, ..Default::default() }, fraction: None, subintervals: examined }
+            }
             Some(b) => self.motion_contact(path.report_at(b.fraction), b.ti, b.level, &b.pose, b.fraction, examined),
         }
     }
