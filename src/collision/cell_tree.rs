@@ -199,6 +199,18 @@ impl<'a> TargetView<'a> {
         (c - h).cmple(b.maxs).all() && b.mins.cmple(c + h).all()
     }
 
+    /// A lower bound on the distance from the target to anything in a box of the surface's frame
+    /// (centre, half extents): the gap between that box, seen from the target's frame, and the
+    /// target's own bounding box (0 when they meet).
+    #[inline]
+    pub fn own_box_gap(&self, centre: Vector, half: Vector) -> Real {
+        let c = self.rotation * centre + self.object_in_target.translation;
+        let h = self.rotation_abs * half;
+        let b = &self.local_aabb;
+        let gap = (b.mins - (c + h)).max(c - h - b.maxs).max(Vector::ZERO);
+        gap.length()
+    }
+
     /// `[min, max]` of `dir . x` over the target where the surface's side makes it a depth (the
     /// minimum for `back`, the maximum for `front`, both for `both`), and the other end from the
     /// target's own box (outside the exact extent): one support query where two were.

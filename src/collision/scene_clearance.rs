@@ -133,7 +133,9 @@ impl Scene {
                 continue;
             }
             let view = TargetView::new(target, &pose, area.side, &target_aabb);
-            let bound = |c: Vector, h: Vector| lower_bound(&view.aabb, view.centre, radius, c, h);
+            // The surface-frame bounds, and the gap to the target's own box (tighter for a
+            // tilted, elongated link).
+            let bound = |c: Vector, h: Vector| lower_bound(&view.aabb, view.centre, radius, c, h).max(view.own_box_gap(c, h));
             let (c, h) = tree.node_box(0);
             let mut stack: Vec<(Real, u32)> = vec![(bound(c, h), 0)];
             while let Some((lb, node)) = stack.pop() {
@@ -156,6 +158,11 @@ impl Scene {
                     if bound(slab.centre(), slab.half()) > best_dist {
                         continue;
                     }
+                    // The gap along the cell's normal (two support queries) before GJK.
+                    let [lo, hi] = view.extent_along(slab.normal);
+                    if (lo - slab.range[1]).max(slab.range[0] - hi) > best_dist {
+                        continue;
+                    }
                     let cell = &area.cells[index as usize];
                     let cell_support = CellSupport(cell.vertices());
                     if let Some((d, p1, p2)) = gjk_distance(&view.object_in_target, &support1, &cell_support, best_dist) {
@@ -170,4 +177,3 @@ impl Scene {
         best
     }
 }
-
