@@ -31,6 +31,12 @@ pub const MAX_COORDINATE: f64 = 1e5;
 pub const MAX_NAMES_IN_ERROR: usize = 8;
 /// Entries one `JointState` field may hold (`msgs::MAX_JOINT_STATE_ENTRIES`, refused while decoding).
 pub use crate::msgs::MAX_JOINT_STATE_ENTRIES;
+/// Points, names and entries of a point's fields a `check_trajectory` request may hold
+/// (`msgs::MAX_TRAJECTORY_ENTRIES`, refused while decoding; the same figures are checked again by
+/// `Pipeline::trajectory_job`, with one-line errors).
+pub use crate::msgs::MAX_TRAJECTORY_ENTRIES;
+/// Motion-check sub-intervals one `check_trajectory` request may spend in all.
+pub use crate::pipeline::MAX_TRAJECTORY_SUBINTERVALS;
 
 /// A file that cannot be read within the bounds.
 #[derive(Debug, thiserror::Error)]
