@@ -117,7 +117,8 @@ pub struct Comparison {
 pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<String>, Vec<f64>)], triangles: usize, dir: &Path) -> Comparison {
     let w = world(triangles);
     let (build_seconds, memory_bytes, cells) = (w.build_seconds, w.memory_bytes, w.scene.cell_count());
-    let params = Params { package_map: map.to_vec(), ..Params::default() };
+    // The peers check the links against the environment only: so does this side.
+    let params = Params { package_map: map.to_vec(), self_collision: false, ..Params::default() };
     let checker = Checker::from_robot_and_scene(params, robot.clone(), w.scene, "panda".into()).unwrap();
 
     // Ours: the full check (all links, all cells, deepest contacts with depth), one core.

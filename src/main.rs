@@ -132,6 +132,10 @@ pub struct ModelArgs {
     /// Side of every thin surface (back, front or both), overriding the parameters.
     #[arg(long, value_parser = parse_side)]
     side: Option<Side>,
+    /// The robot's SRDF (its disable_collisions form the allowed collision matrix), overriding
+    /// the parameters' robot_semantic_file.
+    #[arg(long)]
+    srdf: Option<PathBuf>,
 }
 
 fn main() -> ExitCode {

@@ -24,8 +24,10 @@ fn msg_and_srv_files_parse_with_rosbags() {
     }
     // Field order is wire order: compare with the serde structs' order.
     let contact = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/interfaces/thickness_collision_msgs/msg/Contact.msg")).unwrap();
-    let fields: Vec<&str> = contact.lines().filter_map(|l| l.split('#').next()).filter_map(|l| l.split_whitespace().nth(1)).collect();
-    assert_eq!(fields, ["link_name", "object_name", "triangle", "depth", "position", "normal"]);
+    // Constants (`uint8 ROBOT_LINK=1`) are not fields.
+    let fields: Vec<&str> =
+        contact.lines().filter_map(|l| l.split('#').next()).filter_map(|l| l.split_whitespace().nth(1)).filter(|f| !f.contains('=')).collect();
+    assert_eq!(fields, ["link_name", "object_name", "triangle", "depth", "position", "normal", "object_type"]);
     let report = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/interfaces/thickness_collision_msgs/msg/CollisionReport.msg")).unwrap();
     let fields: Vec<&str> = report.lines().filter_map(|l| l.split('#').next()).filter_map(|l| l.split_whitespace().nth(1)).collect();
     assert_eq!(fields, ["header", "in_collision", "contacts", "check_seconds", "error", "motion", "fraction", "clearances"]);
@@ -57,7 +59,7 @@ fn msg_and_srv_files_parse_with_rosbags() {
     let c = thickness_collision::msgs::ContactMsg::default();
     let v = serde_json::to_value(&c).unwrap();
     let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
-    assert_eq!(keys.len(), 6);
+    assert_eq!(keys.len(), 7);
 }
 
 /// `CheckTrajectory.srv`'s two parts against the serde structs the node sends and receives (field

@@ -2,12 +2,13 @@
 
 use super::joint_state::{resolve_positions, StateError};
 use super::motion::MotionBounds;
-use super::state_report::{ReportContact, StateReport};
+use super::self_collision::SelfPairs;
+use super::state_report::{ObjectType, ReportContact, StateReport};
 use crate::collision::{CollideSettings, ConvexHull, Scene, Target, TargetShape};
 use crate::math::{pose_from_isometry, Pose, Vector};
 use crate::mesh::{MeshTopology, TopologySettings};
 use crate::model::mesh_file::{read_mesh, scale_mesh, MeshData, MeshFileError};
-use crate::model::{bundled_config_dir, GeometrySpec, JointKind, ModelError, PackageResolver, Params, ParamsError, RobotModel};
+use crate::model::{bundled_config_dir, GeometrySpec, JointKind, ModelError, PackageResolver, Params, ParamsError, RobotModel, Srdf};
 use crate::thickness::{Side, ThicknessArea, ThicknessSettings};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use std::collections::HashMap;
@@ -40,6 +41,9 @@ pub enum CheckerError {
     /// use stays.
     #[error("building the checker failed: {0}")]
     Panicked(String),
+    /// The SRDF cannot be read or does not fit the robot.
+    #[error("{0}")]
+    Srdf(String),
     /// A geometry of a link is not usable.
     #[error("{file}: link '{link}': {what}: {message}")]
     Geometry {
@@ -106,6 +110,8 @@ pub struct Checker {
     allowed: Vec<Vec<bool>>,
     /// Levers and grown parts for motion checks, built on the first motion.
     motion: std::sync::OnceLock<MotionBounds>,
+    /// The link pairs checked against each other.
+    self_pairs: SelfPairs,
 }
 
 /// Mesh files read once per build.
@@ -179,6 +185,26 @@ impl Checker {
     /// The pose of the robot's root link in the world (`robot_base_pose`).
     pub fn base_pose(&self) -> &Isometry3<f64> {
         &self.base
+    }
+
+    /// The self-collision pairs and the SRDF they come from.
+    pub fn self_pairs(&self) -> &SelfPairs {
+        &self.self_pairs
+    }
+
+    /// The same checker with the allowed collision matrix of SRDF `text` (`source` names it in
+    /// errors); the robot and environment are kept. An SRDF naming a link or joint the robot
+    /// lacks is refused.
+    pub fn with_semantic(mut self, text: &str, source: &str) -> Result<Checker, CheckerError> {
+        self.apply_semantic(text, source)?;
+        Ok(self)
+    }
+
+    /// As [`Checker::with_semantic`], in place; on error nothing changes.
+    pub fn apply_semantic(&mut self, text: &str, source: &str) -> Result<(), CheckerError> {
+        let srdf = Srdf::parse(text, source, &self.robot).map_err(|e| CheckerError::Srdf(e.to_string()))?;
+        self.self_pairs = SelfPairs::build(self, Some(srdf));
+        Ok(())
     }
 
     pub(crate) fn motion_bounds(&self) -> &MotionBounds {
@@ -353,7 +379,16 @@ impl Checker {
         summary.meshes_read = cache.meshes.len();
         summary.build_seconds = started.elapsed().as_secs_f64();
         let base = base_isometry(&params.robot_base_pose);
-        Ok(Checker { params, robot, targets, scene, summary, base, allowed, motion: std::sync::OnceLock::new() })
+        let semantic_file = params.robot_semantic_file.clone();
+        let checker = Checker { params, robot, targets, scene, summary, base, allowed, motion: std::sync::OnceLock::new(), self_pairs: SelfPairs::default() };
+        if semantic_file.is_empty() {
+            let mut checker = checker;
+            checker.self_pairs = SelfPairs::build(&checker, None);
+            return Ok(checker);
+        }
+        let text = crate::limits::read_regular_text(Path::new(&semantic_file), "SRDF", crate::limits::MAX_DESCRIPTION_BYTES)
+            .map_err(|e| CheckerError::Srdf(format!("robot_semantic_file: {e}")))?;
+        checker.with_semantic(&text, &semantic_file)
     }
 
     /// Checks a joint state given by name, on its own: an unknown name is an error, and a joint
@@ -451,9 +486,13 @@ impl Checker {
                     depth: c.depth,
                     position: c.position.map(|p| p.to_array()),
                     normal: c.normal.to_array(),
+                    object_type: ObjectType::Environment,
                 });
             }
         }
+        // Every colliding self pair, in flag-only checks too (which links collide must not
+        // depend on the mode; a pair costs a bounding-ball test when apart).
+        report.contacts.extend(self.self_contacts(world, false));
         report.in_collision = !report.contacts.is_empty();
         report
     }

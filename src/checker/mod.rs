@@ -8,10 +8,11 @@ mod clearance;
 mod joint_state;
 mod motion;
 mod motion_sweep;
+mod self_collision;
 mod state_report;
 mod world_motion;
 
 pub use self::checker_build::{BuildSummary, Checker, CheckerError, LinkTargets};
 pub use self::joint_state::StateError;
 pub use self::motion::{MotionReport, MAX_SUBINTERVALS};
-pub use self::state_report::{ReportClearance, ReportContact, StateReport};
+pub use self::state_report::{ObjectType, ReportClearance, ReportContact, StateReport};

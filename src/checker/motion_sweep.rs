@@ -5,8 +5,8 @@
 
 use super::checker_build::Checker;
 use super::motion::{grow, MotionReport, MAX_SUBINTERVALS};
-use super::state_report::{ReportContact, StateReport};
-use crate::collision::{CollideSettings, Target, TargetShape};
+use super::state_report::{ObjectType, ReportContact, StateReport};
+use crate::collision::{collide_pair, CollideSettings, PairContact, Target, TargetShape};
 use crate::math::{Pose, Real};
 use std::collections::hash_map::{Entry, HashMap};
 
@@ -40,6 +40,8 @@ struct Blocked {
     ti: usize,
     level: Option<usize>,
     pose: Pose,
+    /// For a self pair: the other target, its level and its pose.
+    other: Option<(usize, Option<usize>, Pose)>,
 }
 
 impl Checker {
@@ -100,7 +102,56 @@ impl Checker {
                     continue;
                 }
                 if level.is_none_or(|l| l == 0) {
-                    blocked = Some(Blocked { fraction: a, ti, level, pose: link_pose });
+                    blocked = Some(Blocked { fraction: a, ti, level, pose: link_pose, other: None });
+                    break;
+                }
+                stack.push((m, b));
+                stack.push((a, m));
+            }
+        }
+        // Self pairs: a pair is cleared on a stretch when its two links at the middle, each grown
+        // by its own displacement bound, do not meet (then they stay apart by more than the sum
+        // of the bounds' worth of motion).
+        for &(ta, tb) in &self.self_pairs().pairs {
+            let (la, lb) = (self.targets()[ta].link, self.targets()[tb].link);
+            stack.clear();
+            stack.push((0.0, 1.0));
+            while let Some((a, b)) = stack.pop() {
+                let limit = blocked.as_ref().map_or(f64::INFINITY, |b| b.fraction);
+                if a >= limit {
+                    continue;
+                }
+                examined += 1;
+                if examined > MAX_SUBINTERVALS {
+                    return failed(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"), examined);
+                }
+                let m = 0.5 * (a + b);
+                let poses = match poses_at.entry(m.to_bits()) {
+                    Entry::Occupied(e) => e.into_mut(),
+                    Entry::Vacant(e) => match path.link_poses(m) {
+                        Ok(p) => e.insert(p),
+                        Err(error) => return failed(error, examined),
+                    },
+                };
+                let (Some(pa), Some(pb)) = (poses[la], poses[lb]) else {
+                    return failed(format!("no pose for link '{}' or '{}'", self.targets()[ta].name, self.targets()[tb].name), examined);
+                };
+                let step = |ti: usize| -> (Option<usize>, bool) {
+                    if speed[ti] > 0.0 {
+                        let delta = path.bound(ti, poses, 0.5 * (b - a));
+                        let level = bounds.level(delta);
+                        let growth = bounds.growth(level);
+                        (Some(level), growth >= delta && (growth <= MAX_TESTED_GROWTH || level == 0))
+                    } else {
+                        (None, true)
+                    }
+                };
+                let ((level_a, tested_a), (level_b, tested_b)) = (step(ta), step(tb));
+                if tested_a && tested_b && self.grown_pair_contact(ta, level_a, &pa, tb, level_b, &pb).is_none() {
+                    continue;
+                }
+                if level_a.is_none_or(|l| l == 0) && level_b.is_none_or(|l| l == 0) {
+                    blocked = Some(Blocked { fraction: a, ti: ta, level: level_a, pose: pa, other: Some((tb, level_b, pb)) });
                     break;
                 }
                 stack.push((m, b));
@@ -113,7 +164,10 @@ impl Checker {
                 let clearances = if self.params().clearance_threshold > 0.0 { path.report_at(1.0).clearances } else { Vec::new() };
                 MotionReport { report: StateReport { motion: true, clearances, ..Default::default() }, fraction: None, subintervals: examined }
             }
-            Some(b) => self.motion_contact(path.report_at(b.fraction), b.ti, b.level, &b.pose, b.fraction, examined),
+            Some(b) => match b.other {
+                None => self.motion_contact(path.report_at(b.fraction), b.ti, b.level, &b.pose, b.fraction, examined),
+                Some(other) => self.motion_self_contact(path.report_at(b.fraction), (b.ti, b.level, b.pose), other, b.fraction, examined),
+            },
         }
     }
 
@@ -137,6 +191,54 @@ impl Checker {
         })
     }
 
+    /// The deepest contact between the parts of targets `ta` and `tb`, each grown by its ladder
+    /// level, at the given link poses.
+    pub(super) fn grown_pair_contact(&self, ta: usize, level_a: Option<usize>, pa: &Pose, tb: usize, level_b: Option<usize>, pb: &Pose) -> Option<PairContact> {
+        let mut best: Option<PairContact> = None;
+        for (ia, (_, oa)) in self.targets()[ta].parts.iter().enumerate() {
+            let part_a = Target::new(self.grown_part(ta, ia, level_a).clone(), *pa * *oa);
+            for (ib, (_, ob)) in self.targets()[tb].parts.iter().enumerate() {
+                let part_b = Target::new(self.grown_part(tb, ib, level_b).clone(), *pb * *ob);
+                if let Some(c) = collide_pair(&part_a, &part_b) {
+                    if best.is_none_or(|x| c.depth > x.depth) {
+                        best = Some(c);
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// As [`Checker::motion_contact`] for a self pair: for a near miss, the pair the grown links
+    /// met as, depth 0.
+    fn motion_self_contact(
+        &self,
+        mut report: StateReport,
+        a: (usize, Option<usize>, Pose),
+        b: (usize, Option<usize>, Pose),
+        fraction: f64,
+        examined: u64,
+    ) -> MotionReport {
+        let (name_a, name_b) = (&self.targets()[a.0].name, &self.targets()[b.0].name);
+        if !report.contacts.iter().any(|c| &c.link_name == name_a && &c.object_name == name_b) {
+            if let Some(c) = self.grown_pair_contact(a.0, a.1, &a.2, b.0, b.1, &b.2) {
+                report.contacts.push(ReportContact {
+                    link_name: name_a.clone(),
+                    object_name: name_b.clone(),
+                    triangle: u32::MAX,
+                    depth: 0.0,
+                    position: Some(c.position.to_array()),
+                    normal: c.normal.to_array(),
+                    object_type: ObjectType::RobotLink,
+                });
+            }
+        }
+        report.in_collision = true;
+        report.motion = true;
+        report.fraction = Some(fraction);
+        MotionReport { report, fraction: Some(fraction), subintervals: examined }
+    }
+
     /// The report of a motion found colliding on the stretch starting at `fraction`: `report` is
     /// that of the pose there; for a near miss (the link does not collide there) the object the
     /// grown link at `link_pose` touched is added, with depth 0.
@@ -155,6 +257,7 @@ impl Checker {
                     depth: 0.0,
                     position: c.position.map(|p| p.to_array()),
                     normal: c.normal.to_array(),
+                    object_type: ObjectType::Environment,
                 });
             }
         }

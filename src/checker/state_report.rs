@@ -17,6 +17,30 @@ pub struct ReportContact {
     pub position: Option<[f64; 3]>,
     /// Push-out direction (world frame).
     pub normal: [f64; 3],
+    /// What `object_name` is: an environment object, or (self-collision) another robot link.
+    #[serde(default)]
+    pub object_type: ObjectType,
+}
+
+/// What a contact's object is, as `Contact.object_type`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectType {
+    /// A link of the environment URDF (a thin surface or a solid).
+    #[default]
+    Environment,
+    /// Another link of the robot: `link_name` is the pair's first link in model order.
+    RobotLink,
+}
+
+impl ObjectType {
+    /// `Contact.ENVIRONMENT` or `Contact.ROBOT_LINK`.
+    pub fn code(self) -> u8 {
+        match self {
+            ObjectType::Environment => 0,
+            ObjectType::RobotLink => 1,
+        }
+    }
 }
 
 /// How near one link is to the environment, as in `thickness_collision_msgs/Clearance`.

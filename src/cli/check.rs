@@ -5,6 +5,7 @@ use crate::ModelArgs;
 use anyhow::{anyhow, bail, Context, Result};
 use std::io::{BufRead, Write};
 use std::path::Path;
+use thickness_collision::checker::ObjectType;
 use thickness_collision::limits::{open_regular, MAX_STATE_LINE_BYTES};
 use thickness_collision::msgs::Time;
 use thickness_collision::pipeline::{parse_state_line, CheckedState};
@@ -45,6 +46,7 @@ pub fn check(args: &ModelArgs, joints: Option<&str>, states: Option<&Path>, json
         s.solids,
         s.build_seconds * 1e3
     );
+    eprintln!("{}", pipeline.checker().self_pairs().summary(pipeline.checker()));
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     if let Some(spec) = joints {
@@ -142,7 +144,11 @@ fn emit(out: &mut impl Write, n: usize, checked: &CheckedState, json: bool) -> R
         writeln!(out, "state {n}: IN COLLISION{limits}")?;
     }
     for c in &report.contacts {
-        let tri = if c.triangle == u32::MAX { "solid".to_string() } else { format!("triangle {}", c.triangle) };
+        let tri = match c.object_type {
+            ObjectType::RobotLink => "robot link".to_string(),
+            ObjectType::Environment if c.triangle == u32::MAX => "solid".to_string(),
+            ObjectType::Environment => format!("triangle {}", c.triangle),
+        };
         let point = c.position.map_or("none".into(), |p| format!("[{:.4}, {:.4}, {:.4}]", p[0], p[1], p[2]));
         writeln!(
             out,

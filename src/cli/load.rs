@@ -19,6 +19,9 @@ pub fn params(args: &ModelArgs) -> Result<Params> {
         params.default_thickness = t;
         params.thin_surfaces.thickness.iter_mut().for_each(|x| *x = t);
     }
+    if let Some(srdf) = &args.srdf {
+        params.robot_semantic_file = srdf.display().to_string();
+    }
     if let Some(side) = args.side {
         params.default_side = side;
         let n = params.thin_surfaces.patterns.len();

@@ -45,7 +45,14 @@ pub(crate) fn hull_cell(hull: &ConvexHull, cell: &[Vector; 6]) -> Verdict {
         (a - b, d.dot(a), b_min)
     };
     let centre = cell.iter().copied().sum::<Vector>() / 6.0;
-    let mut d = centre - hull.centroid;
+    convex_pair(support, centre - hull.centroid)
+}
+
+/// GJK of two convex shapes given by `support(d) = (a - b, d·a, d·b)`, with `a` the first shape's
+/// point extreme along `d` and `b` the second's extreme along `-d`; `d0` a first direction (from
+/// the first shape's centre towards the second's).
+pub(crate) fn convex_pair(support: impl Fn(Vector) -> (Point, Real, Real), d0: Vector) -> Verdict {
+    let mut d = d0;
     if !(d.length_squared() > 1e-24) {
         d = Vector::X;
     }

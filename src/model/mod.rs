@@ -8,8 +8,10 @@ pub mod mesh_file;
 mod package;
 mod params;
 mod robot;
+mod srdf;
 pub mod xml_guard;
 
 pub use self::package::{PackageError, PackageResolver};
 pub use self::params::{bundled_config_dir, glob_match, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};
 pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, PositionsError, RobotModel};
+pub use self::srdf::{Srdf, SrdfError};

@@ -138,6 +138,11 @@ pub struct Params {
     /// Every report lists each checked link within this distance (metres) of the environment,
     /// with its distance and nearest points; 0 turns clearance off.
     pub clearance_threshold: f64,
+    /// The robot's SRDF (its `disable_collisions` form the allowed collision matrix; its groups
+    /// serve `check_state_validity`); empty: none, or what `robot_description_semantic` brings.
+    pub robot_semantic_file: String,
+    /// Check the robot's links against each other.
+    pub self_collision: bool,
 }
 
 impl Default for Params {
@@ -167,6 +172,8 @@ impl Default for Params {
             check_motion: true,
             motion_max_gap: 0.5,
             clearance_threshold: 0.0,
+            robot_semantic_file: String::new(),
+            self_collision: true,
         }
     }
 }
@@ -277,7 +284,10 @@ impl Params {
             return bad("motion_max_gap", format!("must be from 0 to {MAX_MOTION_GAP} s, got {}", crate::limits::show_number(self.motion_max_gap)));
         }
         if !(0.0..=MAX_CLEARANCE).contains(&self.clearance_threshold) {
-            return bad("clearance_threshold", format!("must be from 0 (off) to {MAX_CLEARANCE} m, got {}", crate::limits::show_number(self.clearance_threshold)));
+            return bad(
+                "clearance_threshold",
+                format!("must be from 0 (off) to {MAX_CLEARANCE} m, got {}", crate::limits::show_number(self.clearance_threshold)),
+            );
         }
         if let Some(p) = self.padding.values.iter().find(|p| !(**p >= 0.0 && **p <= hi)) {
             return bad("padding.values", format!("must be from 0 to {hi:e} m, got {p:?}"));

@@ -33,7 +33,9 @@ fn bounded_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<V
             let mut out = Vec::with_capacity(seq.size_hint().unwrap_or(0).min(1024));
             while let Some(x) = seq.next_element()? {
                 if out.len() == MAX_JOINT_STATE_ENTRIES {
-                    return Err(serde::de::Error::custom(format!("a joint state field of more than {MAX_JOINT_STATE_ENTRIES} entries; at most {MAX_JOINT_STATE_ENTRIES} allowed")));
+                    return Err(serde::de::Error::custom(format!(
+                        "a joint state field of more than {MAX_JOINT_STATE_ENTRIES} entries; at most {MAX_JOINT_STATE_ENTRIES} allowed"
+                    )));
                 }
                 out.push(x);
             }
@@ -174,6 +176,15 @@ pub struct ContactMsg {
     pub position: Point,
     /// Push-out direction.
     pub normal: Vector3,
+    /// [`ContactMsg::ENVIRONMENT`] or [`ContactMsg::ROBOT_LINK`].
+    pub object_type: u8,
+}
+
+impl ContactMsg {
+    /// `object_name` is an environment object.
+    pub const ENVIRONMENT: u8 = 0;
+    /// `object_name` is another robot link (self-collision).
+    pub const ROBOT_LINK: u8 = 1;
 }
 
 /// `thickness_collision_msgs/msg/CollisionReport`.
@@ -213,7 +224,6 @@ pub struct ClearanceMsg {
     /// Nearest point on the object; the contact point when colliding.
     pub point_on_object: Point,
 }
-
 
 /// `std_msgs/msg/ColorRGBA`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]

@@ -48,6 +48,7 @@ pub fn report_message(report: &StateReport, stamp: Time, frame: &str) -> Collisi
         // never reach a message) would be NaN.
         position: v(c.position.unwrap_or([f64::NAN; 3])),
         normal: v(c.normal),
+        object_type: c.object_type.code(),
     };
     CollisionReport {
         header: Header { stamp, frame_id: frame.to_owned() },

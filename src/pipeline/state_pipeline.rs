@@ -67,6 +67,9 @@ pub struct Pipeline {
     last_stamp: Option<Time>,
     /// The last state checked or covered by a report: where the next motion starts.
     trail: Option<RobotState>,
+    /// The latest `robot_description_semantic` (SRDF text, and what to call it): applied to
+    /// every robot built after it that it fits.
+    semantic: Option<(Arc<str>, String)>,
 }
 
 impl Pipeline {
@@ -90,6 +93,7 @@ impl Pipeline {
             warnings: Vec::new(),
             last_stamp: None,
             trail: None,
+            semantic: None,
         }
     }
 
@@ -300,8 +304,9 @@ impl Pipeline {
     /// current robot stays. Merged joint positions are dropped when the new robot's joints differ.
     pub fn set_robot_description(&mut self, urdf: &str, source: &str) -> Result<(), CheckerError> {
         let params = self.params().clone();
-        let checker =
+        let mut checker =
             crate::limits::contain_panic(|| Checker::from_description(params, urdf, source, self.environment.as_deref())).map_err(CheckerError::Panicked)??;
+        self.apply_latest_semantic(&mut checker);
         self.source = RobotSource::Description { urdf: urdf.into(), source: source.to_owned() };
         self.replace(checker);
         Ok(())
@@ -310,13 +315,48 @@ impl Pipeline {
     /// New parameters: the checker is rebuilt with the robot from the same source (a robot
     /// received as a description stays); on error everything stays as it was.
     pub fn set_params(&mut self, params: Params) -> Result<(), CheckerError> {
-        let checker = crate::limits::contain_panic(|| match &self.source {
+        let checker = self.rebuild(params)?;
+        self.replace(checker);
+        Ok(())
+    }
+
+    /// A new SRDF (a `robot_description_semantic` message), swapped in whole: its
+    /// `disable_collisions` become the allowed collision matrix and its groups serve
+    /// `check_state_validity`. One naming a link or joint the robot lacks is refused and the
+    /// current matrix stays; it is tried again on every robot that arrives later.
+    pub fn set_robot_semantic(&mut self, text: &str, source: &str) -> Result<(), CheckerError> {
+        // Kept even when it does not fit this robot: the robot it belongs to may come next.
+        self.semantic = Some((text.into(), source.to_owned()));
+        let mut checker = self.build_from_source(self.params().clone())?;
+        crate::limits::contain_panic(|| checker.apply_semantic(text, source)).map_err(CheckerError::Panicked)??;
+        self.replace(checker);
+        Ok(())
+    }
+
+    /// The checker for `params` with the robot from the current source, and the latest SRDF
+    /// received when it fits (else the parameters' file or the default pairs, with a warning).
+    fn rebuild(&mut self, params: Params) -> Result<Checker, CheckerError> {
+        let mut checker = self.build_from_source(params)?;
+        self.apply_latest_semantic(&mut checker);
+        Ok(checker)
+    }
+
+    fn build_from_source(&self, params: Params) -> Result<Checker, CheckerError> {
+        crate::limits::contain_panic(|| match &self.source {
             RobotSource::Files { robot } => Checker::from_params(params, robot.as_deref(), self.environment.as_deref()),
             RobotSource::Description { urdf, source } => Checker::from_description(params, urdf, source, self.environment.as_deref()),
         })
-        .map_err(CheckerError::Panicked)??;
-        self.replace(checker);
-        Ok(())
+        .map_err(CheckerError::Panicked)?
+    }
+
+    fn apply_latest_semantic(&mut self, checker: &mut Checker) {
+        if let Some((text, source)) = &self.semantic {
+            match crate::limits::contain_panic(|| checker.apply_semantic(text, source)) {
+                Ok(Ok(())) => {}
+                Ok(Err(e)) => self.warnings.push(format!("the SRDF from {source} does not fit this robot ({e}); its self-collision pairs are not used")),
+                Err(e) => self.warnings.push(format!("the SRDF from {source} could not be applied: {e}")),
+            }
+        }
     }
 
     fn replace(&mut self, checker: Checker) {

@@ -16,6 +16,7 @@ use std::time::Instant;
 
 /// The topic a `robot_description` is recorded on.
 const DESCRIPTION_TOPIC: &str = "/robot_description";
+const SEMANTIC_TOPIC: &str = "/robot_description_semantic";
 
 /// What to replay and where the results go.
 #[derive(Clone, Debug, Default)]
@@ -55,6 +56,8 @@ pub struct ReplaySummary {
     pub skipped: BTreeMap<SkipCause, u64>,
     /// `robot_description` messages applied, and refused.
     pub descriptions: (usize, usize),
+    /// `/robot_description_semantic` messages (SRDF) applied and refused.
+    pub semantics: (usize, usize),
     /// Wall time of the replay loop (seconds), reading and writing included.
     pub seconds: f64,
     /// The fault that ended the bag early, if any (reports before it are kept).
@@ -72,6 +75,9 @@ impl std::fmt::Display for ReplaySummary {
         writeln!(f, "time: {:.3} s, {per:.2} us per state ({:.0} states/s)", self.seconds, self.states as f64 / self.seconds.max(1e-12))?;
         if self.descriptions != (0, 0) {
             writeln!(f, "robot descriptions: {} applied, {} refused", self.descriptions.0, self.descriptions.1)?;
+        }
+        if self.semantics != (0, 0) {
+            writeln!(f, "robot semantic descriptions (SRDF): {} applied, {} refused", self.semantics.0, self.semantics.1)?;
         }
         let total: u64 = self.skipped.values().sum();
         write!(f, "skipped messages: {total}")?;
@@ -201,6 +207,9 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
         let state = if m.topic == DESCRIPTION_TOPIC {
             apply_description(&mut pipeline, &m, &opts.bag, &mut summary, &mut warnings);
             continue;
+        } else if m.topic == SEMANTIC_TOPIC {
+            apply_semantic(&mut pipeline, &m, &opts.bag, &mut summary, &mut warnings);
+            continue;
         } else if pose_source == PoseSource::Tf && m.topic == "/tf_static" {
             match decode::<TfMessage>(&mut pipeline, &m, &mut warnings) {
                 Some(msg) => pipeline.tf_static(&msg).map(|()| None),
@@ -275,6 +284,23 @@ fn apply_description(pipeline: &mut Pipeline, m: &BagMessage, bag: &Path, summar
         Err(e) => {
             summary.descriptions.1 += 1;
             warnings.warn("description", || format!("{source} refused, keeping the current robot: {e}"));
+        }
+    }
+}
+
+/// An SRDF in the bag, applied at its log time as the node applies `robot_description_semantic`.
+fn apply_semantic(pipeline: &mut Pipeline, m: &BagMessage, bag: &Path, summary: &mut ReplaySummary, warnings: &mut FirstWarnings) {
+    let source = format!("{SEMANTIC_TOPIC} in {} at log time {} ns", bag.display(), m.log_time);
+    let result =
+        decode_cdr::<StringMsg>(&m.data).map_err(|e| e.to_string()).and_then(|d| pipeline.set_robot_semantic(&d.data, &source).map_err(|e| e.to_string()));
+    match result {
+        Ok(()) => {
+            summary.semantics.0 += 1;
+            eprintln!("thickness_collision: {}", pipeline.checker().self_pairs().summary(pipeline.checker()));
+        }
+        Err(e) => {
+            summary.semantics.1 += 1;
+            warnings.warn("semantic", || format!("{source} refused, keeping the current collision matrix: {e}"));
         }
     }
 }

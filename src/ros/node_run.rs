@@ -114,6 +114,7 @@ struct Interfaces {
     states: ros2_client::Subscription<JointState>,
     tf: Option<(ros2_client::Subscription<TfMessage>, ros2_client::Subscription<TfMessage>)>,
     descriptions: ros2_client::Subscription<DescriptionMsg>,
+    semantics: ros2_client::Subscription<DescriptionMsg>,
     clock: Option<ros2_client::Subscription<ClockMsg>>,
     collisions: ros2_client::Publisher<CollisionReport>,
     cells: ros2_client::Publisher<MarkerArray>,
@@ -133,6 +134,7 @@ struct Names {
     check_trajectory: String,
     check_state_validity: String,
     description: String,
+    semantic: String,
     cells: String,
     contacts: String,
 }
@@ -156,6 +158,7 @@ impl Interfaces {
             check_trajectory: resolve(remaps, "check_trajectory"),
             check_state_validity: resolve(remaps, "check_state_validity"),
             description: resolve(remaps, "robot_description"),
+            semantic: resolve(remaps, "robot_description_semantic"),
             cells: resolve(remaps, "collision_markers/cells"),
             contacts: resolve(remaps, "collision_markers/contacts"),
         };
@@ -179,6 +182,9 @@ impl Interfaces {
         let desc_qos = latched(QosProfile::subscription_default(), 1);
         let desc = topic(node, &names.description, &namespace, "std_msgs", "String", &desc_qos)?;
         let descriptions = node.create_subscription::<DescriptionMsg>(&desc, Some(desc_qos.clone())).map_err(sub_err(&names.description))?;
+        // The SRDF, latched as move_group offers it; bounded like the description.
+        let sem = topic(node, &names.semantic, &namespace, "std_msgs", "String", &desc_qos)?;
+        let semantics = node.create_subscription::<DescriptionMsg>(&sem, Some(desc_qos.clone())).map_err(sub_err(&names.semantic))?;
         let clock = if params.use_sim_time {
             let t = topic(node, "/clock", "/", "rosgraph_msgs", "Clock", &best_effort(1))?;
             Some(node.create_subscription::<ClockMsg>(&t, None).map_err(sub_err("/clock"))?)
@@ -244,6 +250,7 @@ impl Interfaces {
             states,
             tf,
             descriptions,
+            semantics,
             clock,
             collisions,
             cells,
@@ -287,6 +294,7 @@ enum Event {
     Tf(TfMessage),
     TfStatic(TfMessage),
     Description(DescriptionMsg),
+    Semantic(DescriptionMsg),
     Clock(Time),
     Request(ros2_client::service::RmwRequestId, CheckStatesRequest),
     TrajectoryRequest(ros2_client::service::RmwRequestId, CheckTrajectoryRequest),
@@ -528,6 +536,36 @@ impl NodeState {
         }
     }
 
+    /// A new SRDF from `robot_description_semantic`, swapped in whole by the pipeline; a refused
+    /// one (it names links or joints the robot lacks) leaves the current matrix, as a refused
+    /// description does.
+    fn on_semantic(&mut self, io: &Interfaces, msg: DescriptionMsg) {
+        let source = format!("{} topic", io.names.semantic);
+        let result = match msg {
+            DescriptionMsg::Text(text) => self.pipeline.set_robot_semantic(&text, &source).map_err(|e| e.to_string()),
+            DescriptionMsg::TooLarge(n) => Err(format!("{source}: {n} bytes of SRDF text, more than the {MAX_DESCRIPTION_BYTES} allowed")),
+        };
+        self.warn_pending();
+        match result {
+            Ok(()) => {
+                println!(
+                    "thickness_collision: SRDF from {}: {} self-collision pairs checked",
+                    io.names.semantic,
+                    self.pipeline.checker().self_pairs().pairs.len()
+                );
+                self.description_error = None;
+            }
+            Err(e) => {
+                let line = format!("{} rejected, keeping the current collision matrix: {}", io.names.semantic, e.replace('\n', " "));
+                eprintln!("[ERROR] thickness_collision: {line}");
+                if self.log.pending.len() < 64 {
+                    self.log.pending.push(line.clone());
+                }
+                self.description_error = Some(line);
+            }
+        }
+    }
+
     async fn on_request(&mut self, io: &Interfaces, id: ros2_client::service::RmwRequestId, req: CheckStatesRequest) {
         let reports = self.pipeline.check_request(&req.states);
         for r in reports.iter().filter(|r| !r.error.is_empty()) {
@@ -673,6 +711,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
             s.solids,
             s.build_seconds * 1e3
         );
+        println!("  {}", pipeline.checker().self_pairs().summary(pipeline.checker()));
         let input = match p.pose_source {
             PoseSource::Tf => format!("/tf and /tf_static (tf2_msgs/msg/TFMessage, frame prefix '{}')", p.frame_prefix),
             PoseSource::JointStates => format!("{} (sensor_msgs/msg/JointState)", io.names.joint_states),
@@ -739,6 +778,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let mut tfs: Stream<TfMessage> = stream_of(io.tf.as_ref().map(|t| &t.0));
         let mut tf_statics: Stream<TfMessage> = stream_of(io.tf.as_ref().map(|t| &t.1));
         let mut descriptions: Stream<DescriptionMsg> = stream_of(Some(&io.descriptions));
+        let mut semantics: Stream<DescriptionMsg> = stream_of(Some(&io.semantics));
         let mut clocks: Stream<ClockMsg> = stream_of(io.clock.as_ref());
         let mut requests = io.check_states.receive_request_stream();
         let mut trajectories = io.check_trajectory.receive_request_stream();
@@ -754,6 +794,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 m = tfs.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/tf", e), |(m, _)| Event::Tf(m)),
                 m = tf_statics.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/tf_static", e), |(m, _)| Event::TfStatic(m)),
                 m = descriptions.select_next_some() => m.map_or_else(|e| Event::ReadFailed("robot_description", e), |(m, _)| Event::Description(m)),
+                m = semantics.select_next_some() => m.map_or_else(|e| Event::ReadFailed("robot_description_semantic", e), |(m, _)| Event::Semantic(m)),
                 m = clocks.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/clock", e), |(m, _)| Event::Clock(m.clock)),
                 r = requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_states", e), |(id, req)| Event::Request(id, req)),
                 r = trajectories.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_trajectory", e), |(id, req)| Event::TrajectoryRequest(id, req)),
@@ -769,6 +810,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 Event::Tf(m) => state.on_tf(&io, m).await,
                 Event::TfStatic(m) => state.on_tf_static(m),
                 Event::Description(m) => state.on_description(&io, m),
+                Event::Semantic(m) => state.on_semantic(&io, m),
                 Event::Clock(t) => state.sim_time = Some(t),
                 Event::Request(id, req) => state.on_request(&io, id, req).await,
                 Event::TrajectoryRequest(id, req) => state.on_trajectory_request(&io, &worker, id, req).await,

@@ -27,6 +27,15 @@ pub fn start_node_wrapped(wrapper: &[&str], args: &[&str], domain: u32) -> (Chil
         }
         None => Command::new(bin),
     };
+    // The node ends with the test thread that started it: a test that fails before its own
+    // SIGTERM must not leave a node running on its domain (it would answer the next test's peer).
+    // SAFETY: prctl is async-signal-safe; nothing else runs between fork and exec here.
+    unsafe {
+        let _ = std::os::unix::process::CommandExt::pre_exec(&mut command, || {
+            let _ = libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
+            Ok(())
+        });
+    }
     let mut node = command
         .arg("run")
         .args(args)

@@ -30,7 +30,7 @@ Transform = struct_typed("geometry_msgs/msg/Transform", [("translation", Vector3
 TransformStamped = struct_typed("geometry_msgs/msg/TransformStamped", [("header", Header), ("child_frame_id", str), ("transform", Transform)])
 TFMessage = struct_typed("tf2_msgs/msg/TFMessage", [("transforms", t.sequence[TransformStamped])])
 KNOWN = {"std_msgs/Header": Header, "geometry_msgs/Point": Point, "geometry_msgs/Vector3": Vector3, "sensor_msgs/JointState": JointState}
-PRIMS = {"string": str, "bool": bool, "uint32": t.uint32, "int32": t.int32, "float64": t.float64}
+PRIMS = {"string": str, "bool": bool, "uint8": t.uint8, "uint32": t.uint32, "int32": t.int32, "float64": t.float64}
 
 
 def from_msg(pkg, kind, name, text, local):
@@ -38,7 +38,7 @@ def from_msg(pkg, kind, name, text, local):
     fields = []
     for line in text.splitlines():
         line = line.split("#", 1)[0].strip()
-        if not line:
+        if not line or "=" in line:  # a blank line, or a constant (not on the wire)
             continue
         ty, fname = line.split()[:2]
         seq = ty.endswith("[]")
