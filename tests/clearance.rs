@@ -45,7 +45,7 @@ fn reported_clearances_match_parry_distance_to_every_cell_within_the_threshold()
         }
     }
     let (mut near_states, mut checked_states) = (0, 0);
-    let (mut reported, mut colliding, mut worst) = (0usize, 0usize, 0.0 as Real);
+    let (mut reported, mut colliding, mut worst): (usize, usize, Real) = (0, 0, 0.0);
     let mut seed = 7;
     while near_states < 2_000 {
         let states = random_states(&robot, 500, seed);
