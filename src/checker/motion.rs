@@ -210,6 +210,23 @@ impl MotionPath for JointPath<'_> {
     fn report_at(&self, s: f64) -> StateReport {
         self.checker.check_positions(&self.at(s)).unwrap_or_else(|e| StateReport::failed(e.to_string()))
     }
+
+    /// In the frame of the last link upstream of both: only the joints that move one of the two
+    /// and not the other count (a joint above both turns the pair as one body). Each with its
+    /// lever bound over all configurations; the world bounds when those are smaller in sum.
+    fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], half: f64) -> (Real, Real) {
+        let levers = &self.checker.motion_bounds().levers;
+        let own = |x: usize, y: usize| -> Real {
+            levers[x].iter().filter(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).map(|(j, r)| self.delta[*j].abs() * r).sum()
+        };
+        let relative = (half * own(a, b), half * own(b, a));
+        let world = (self.bound(a, poses, half), self.bound(b, poses, half));
+        if relative.0 + relative.1 <= world.0 + world.1 {
+            relative
+        } else {
+            world
+        }
+    }
 }
 
 impl Checker {

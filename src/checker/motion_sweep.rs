@@ -31,7 +31,18 @@ pub(super) trait MotionPath {
     }
     /// The report of the state at `s` (its contacts are those of a motion found colliding there).
     fn report_at(&self, s: f64) -> StateReport;
+    /// Bounds for self pair `(a, b)` within `half` of `s`: how far each target's points move, both
+    /// measured in the same frame (the world, or a frame the two share, such as the last link
+    /// upstream of both: the joints above it move the pair rigidly and do not change their
+    /// distance).
+    fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], half: f64) -> (Real, Real) {
+        (self.bound(a, poses, half), self.bound(b, poses, half))
+    }
 }
+
+/// Link poses kept for reuse at most (cleared past this): a motion that needs millions of
+/// midpoints must not keep a pose set for each.
+const MAX_CACHED_POSES: usize = 4096;
 
 /// Where a motion could not be cleared: the start of the stretch, the target, the ladder level it
 /// was grown by and its pose at the stretch's middle.
@@ -76,6 +87,9 @@ impl Checker {
                     return failed(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"), examined);
                 }
                 let m = 0.5 * (a + b);
+                if poses_at.len() >= MAX_CACHED_POSES {
+                    poses_at.clear();
+                }
                 let poses = match poses_at.entry(m.to_bits()) {
                     Entry::Occupied(e) => e.into_mut(),
                     Entry::Vacant(e) => match path.link_poses(m) {
@@ -126,6 +140,9 @@ impl Checker {
                     return failed(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"), examined);
                 }
                 let m = 0.5 * (a + b);
+                if poses_at.len() >= MAX_CACHED_POSES {
+                    poses_at.clear();
+                }
                 let poses = match poses_at.entry(m.to_bits()) {
                     Entry::Occupied(e) => e.into_mut(),
                     Entry::Vacant(e) => match path.link_poses(m) {
@@ -136,9 +153,9 @@ impl Checker {
                 let (Some(pa), Some(pb)) = (poses[la], poses[lb]) else {
                     return failed(format!("no pose for link '{}' or '{}'", self.targets()[ta].name, self.targets()[tb].name), examined);
                 };
-                let step = |ti: usize| -> (Option<usize>, bool) {
-                    if speed[ti] > 0.0 {
-                        let delta = path.bound(ti, poses, 0.5 * (b - a));
+                let (delta_a, delta_b) = path.pair_bound(ta, tb, poses, 0.5 * (b - a));
+                let step = |delta: Real| -> (Option<usize>, bool) {
+                    if delta > 0.0 {
                         let level = bounds.level(delta);
                         let growth = bounds.growth(level);
                         (Some(level), growth >= delta && (growth <= MAX_TESTED_GROWTH || level == 0))
@@ -146,7 +163,7 @@ impl Checker {
                         (None, true)
                     }
                 };
-                let ((level_a, tested_a), (level_b, tested_b)) = (step(ta), step(tb));
+                let ((level_a, tested_a), (level_b, tested_b)) = (step(delta_a), step(delta_b));
                 if tested_a && tested_b && self.grown_pair_contact(ta, level_a, &pa, tb, level_b, &pb).is_none() {
                     continue;
                 }
