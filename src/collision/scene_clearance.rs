@@ -177,3 +177,60 @@ impl Scene {
         best
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Rotation;
+    use crate::mesh::{generate, MeshTopology, TopologySettings};
+    use crate::thickness::{ThicknessArea, ThicknessSettings};
+
+    /// Against closed-form distances (fixed seed): a sphere, a capsule and a cylinder beside a
+    /// box solid (the nearest point on a box face, away from its edges), and a cube above a flat
+    /// sheet whose cells lie behind it; nothing reported beyond the threshold.
+    #[test]
+    fn distances_match_closed_forms() {
+        let mut rng = oorandom::Rand64::new(13);
+        let mut rf = |lo: Real, hi: Real| lo + (hi - lo) * rng.rand_float();
+        let mut scene = Scene::new();
+        let _ = scene.add_solid("block", Pose::IDENTITY, TargetShape::cuboid(Vector::new(0.2, 0.2, 0.2)).unwrap());
+        let (v, t) = generate::flat_grid(20, 20, 1.0, 1.0);
+        let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).unwrap();
+        let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: 0.02, ..Default::default() }).unwrap();
+        let _ = scene.add_surface("sheet", Pose::from_translation(Vector::new(2.0, 0.0, 0.0)), area);
+        for _ in 0..500 {
+            let gap = rf(1e-4, 0.08);
+            let (y, z) = (rf(-0.1, 0.1), rf(-0.1, 0.1));
+            // A sphere of radius r beside the face x = 0.2.
+            let r = rf(0.01, 0.05);
+            let sphere = Target::new(TargetShape::Sphere { radius: r }, Pose::from_translation(Vector::new(0.2 + gap + r, y, z)));
+            // A capsule lying along y (its axis turned from z), beside the face x = 0.2.
+            let capsule = Target::new(
+                TargetShape::Capsule { half_height: 0.05, radius: r },
+                Pose::from_parts(Vector::new(0.2 + gap + r, y * 0.3, z), Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2)),
+            );
+            // A cylinder standing on the top face z = 0.2.
+            let cylinder = Target::new(TargetShape::Cylinder { half_height: 0.03, radius: r }, Pose::from_translation(Vector::new(y, z, 0.2 + gap + 0.03)));
+            // A cube above the sheet (whose cells lie behind its plane z = 0).
+            let cube = Target::new(TargetShape::cuboid(Vector::splat(0.03)).unwrap(), Pose::from_translation(Vector::new(2.5 + y, 0.5 + z, gap + 0.03)));
+            for (what, target, object) in [("sphere", &sphere, 0), ("capsule", &capsule, 0), ("cylinder", &cylinder, 0), ("cube", &cube, 1)] {
+                let c = scene.clearance_filtered(target, 0.05, |_| true);
+                if gap > 0.05 {
+                    assert!(c.is_none(), "{what}: {gap} m away, beyond the threshold: {c:?}");
+                    continue;
+                }
+                let c = c.unwrap_or_else(|| panic!("{what}: {gap} m away, not reported"));
+                assert_eq!(c.object, object);
+                assert!((c.distance - gap).abs() < 1e-7, "{what}: {} against {gap}", c.distance);
+                assert!(((c.point1 - c.point2).length() - gap).abs() < 1e-7, "{what}: points {c:?}");
+                assert_eq!(c.triangle == u32::MAX, object == 0);
+            }
+        }
+        assert!(scene.clearance_filtered(&sphere_at(0.21), 0.0, |_| true).is_none(), "a threshold of 0 is off");
+        assert!(scene.clearance_filtered(&sphere_at(0.21), 0.05, |_| false).is_none(), "filtered objects are skipped");
+    }
+
+    fn sphere_at(x: Real) -> Target {
+        Target::new(TargetShape::Sphere { radius: 0.005 }, Pose::from_translation(Vector::new(x, 0.0, 0.0)))
+    }
+}

@@ -544,9 +544,12 @@ mod tests {
         assert_eq!(p.clearance_threshold, 0.0, "off unless asked for");
         let q = p.with_overrides(&[("clearance_threshold".into(), "0.05".into())]).unwrap();
         assert_eq!(q.clearance_threshold, 0.05);
-        for v in ["-0.01", "11", ".nan", ".inf"] {
-            let e = p.with_overrides(&[("clearance_threshold".into(), v.into())]).unwrap_err().to_string();
-            assert!(e.contains("clearance_threshold") && e.contains("must be from 0 (off) to 10 m") && !e.contains('\n'), "clearance_threshold:={v}: {e}");
+        let says = |e: String, what: &str| assert!(e.contains("clearance_threshold") && e.contains("must be from 0 (off) to 10 m") && !e.contains('\n'), "{what}: {e}");
+        for v in ["-0.01", "11", "-1e-9"] {
+            says(p.with_overrides(&[("clearance_threshold".into(), v.into())]).unwrap_err().to_string(), v);
+        }
+        for v in [f64::NAN, f64::INFINITY] {
+            says(Params { clearance_threshold: v, ..Params::default() }.validate().unwrap_err().to_string(), &format!("{v}"));
         }
     }
 
