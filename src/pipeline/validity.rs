@@ -26,7 +26,7 @@
 //! [`ValidityJob::run`], holding the checker it started with, runs on any thread.
 
 use super::Pipeline;
-use crate::checker::{Checker, ReportContact};
+use crate::checker::{Checker, ObjectType, ReportContact};
 use crate::limits::name_list;
 use crate::model::{MissingJoint, RobotModel};
 use crate::msgs::moveit::{ContactInformation, GetStateValidityRequest, GetStateValidityResponse, BODY_ROBOT_LINK, BODY_WORLD_OBJECT};
@@ -173,12 +173,10 @@ fn group_links(checker: &Checker, name: &str) -> (Option<Vec<bool>>, Option<Stri
     }
 }
 
-/// The joints of SRDF group `name` (by joint index), `None` for a group the robot lacks.
-///
-/// No SRDF groups are loaded yet (issue 13, part 1): every group is unknown. Once the checker
-/// resolves groups, this is the one line to change.
-fn group_joints(_checker: &Checker, _name: &str) -> Option<Vec<usize>> {
-    None
+/// The joints of SRDF group `name` (by joint index), `None` for a group the robot lacks or
+/// without an SRDF.
+fn group_joints(checker: &Checker, name: &str) -> Option<Vec<usize>> {
+    checker.self_pairs().srdf.as_ref()?.group_joints(name, checker.robot())
 }
 
 /// The links `joints` move: each joint's child link and all its descendants.
@@ -242,10 +240,9 @@ impl ValidityJob {
     }
 }
 
-/// Whether a contact is between two robot links (self-collision). None exist yet (issue 13,
-/// part 1); with them the report contact says so.
-fn is_self_contact(_c: &ReportContact) -> bool {
-    false
+/// Whether a contact is between two robot links (self-collision).
+fn is_self_contact(c: &ReportContact) -> bool {
+    c.object_type == ObjectType::RobotLink
 }
 
 /// A report contact as `moveit_msgs/ContactInformation`: body 1 the robot link, body 2 the
@@ -380,6 +377,34 @@ mod tests {
                 assert!(moved[j.child], "{} is below the elbow", robot.links[j.child].name);
             }
         }
+        // A group of the SRDF: the contacts of the links it moves, no warning.
+        let mut with_srdf = arm(MissingJoint::Last);
+        let srdf = r#"<robot name="tc_arm"><group name="forearm"><joint name="elbow_joint"/></group></robot>"#;
+        with_srdf.set_robot_semantic(srdf, "test SRDF").unwrap();
+        let robot = with_srdf.checker().robot();
+        let (mut kept, mut dropped) = (0, 0);
+        for q in [[1.2, 0.3], [0.0, 0.0], [0.6, 1.5], [-0.4, 2.2], [1.6, 0.0], [0.9, 1.0]] {
+            let mut req = request(&["shoulder_lift_joint", "elbow_joint"], &q);
+            let (whole, _) = with_srdf.check_validity(&req);
+            req.group_name = "forearm".into();
+            let job = with_srdf.validity_job(&req);
+            assert_eq!(job.warning(), None);
+            let (group, why) = job.run();
+            assert_eq!(why, None);
+            let want: Vec<&ContactInformation> = whole
+                .contacts
+                .iter()
+                .filter(|c| {
+                    moved[robot.link(&c.contact_body_1).unwrap()]
+                        || (c.body_type_2 == BODY_ROBOT_LINK && robot.link(&c.contact_body_2).is_some_and(|l| moved[l]))
+                })
+                .collect();
+            assert_eq!(group.contacts.iter().collect::<Vec<_>>(), want, "{q:?}");
+            assert_eq!(group.valid, want.is_empty());
+            kept += want.len();
+            dropped += whole.contacts.len() - want.len();
+        }
+        assert!(kept > 0 && dropped > 0, "the cases must show contacts kept ({kept}) and dropped ({dropped}) by the group");
         let job = p.validity_job(&GetStateValidityRequest { group_name: "no_such_group".into(), ..Default::default() });
         assert!(job.warning().unwrap_or_default().contains("'no_such_group'"));
         assert!(job.plan.as_ref().unwrap().links.is_none(), "an unknown group is the whole robot");
