@@ -10,7 +10,14 @@ use crate::math::{Pose, Real, Vector};
 /// against (`allowed[object]` false), or `None` when nothing is that close. A colliding link
 /// (`contact`, its deepest contact) reports minus that contact's depth, with both points at the
 /// contact point, so that the distance is signed and agrees with the contacts.
-pub(crate) fn link_clearance(scene: &Scene, allowed: &[bool], link: &LinkTargets, link_pose: Pose, contact: Option<&Contact>, threshold: Real) -> Option<ReportClearance> {
+pub(crate) fn link_clearance(
+    scene: &Scene,
+    allowed: &[bool],
+    link: &LinkTargets,
+    link_pose: Pose,
+    contact: Option<&Contact>,
+    threshold: Real,
+) -> Option<ReportClearance> {
     if !(threshold > 0.0) {
         return None;
     }
