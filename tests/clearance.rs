@@ -176,3 +176,40 @@ fn clearances_reach_the_json_and_the_message() {
     }
     assert!(seen > 20, "{seen} states with a clearance");
 }
+
+/// A free motion's report carries the clearances of its end pose.
+#[test]
+fn a_free_motion_reports_its_end_pose_clearances() {
+    let py = python();
+    let (robot, map) = panda(&py);
+    let checker = Checker::from_robot_and_scene(
+        Params { package_map: map, clearance_threshold: THRESHOLD, ..Params::default() },
+        robot.clone(),
+        world(2_000).scene,
+        "panda".into(),
+    )
+    .unwrap();
+    let full = |pos: &[f64]| {
+        let mut q = vec![0.0; robot.joints.len()];
+        for (j, p) in robot.joints.iter().filter(|j| j.is_actuated()).zip(pos) {
+            q[robot.joint(&j.name).unwrap()] = *p;
+        }
+        q
+    };
+    let states = random_states(&robot, 400, 5);
+    let (mut free_near, mut free) = (0, 0);
+    for pair in states.windows(2) {
+        let q0 = full(&pair[0].1);
+        // A short motion: a tenth of the way to the next random state.
+        let q1: Vec<f64> = q0.iter().zip(full(&pair[1].1)).map(|(a, b)| a + 0.1 * (b - a)).collect();
+        let motion = checker.check_motion(&q0, &q1);
+        if motion.report.in_collision {
+            continue;
+        }
+        free += 1;
+        let end = checker.check_positions(&q1).unwrap();
+        assert_eq!(motion.report.clearances, end.clearances);
+        free_near += usize::from(!end.clearances.is_empty());
+    }
+    assert!(free > 50 && free_near > 10, "{free} free motions, {free_near} of them ending near a surface");
+}
