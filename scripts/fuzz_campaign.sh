@@ -18,7 +18,7 @@ ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
 CPU_SECONDS=${FUZZ_CPU_SECONDS:-600}
 JOBS=${FUZZ_JOBS:-2}
-ALL_TARGETS=(urdf mesh_stl mesh_obj mesh_dae cdr state_line params_yaml bag_mcap bag_sqlite)
+ALL_TARGETS=(urdf mesh_stl mesh_obj mesh_dae cdr state_line params_yaml bag_mcap bag_sqlite check_trajectory check_state_validity srdf)
 if [ $# -gt 0 ]; then TARGETS=("$@"); else TARGETS=("${ALL_TARGETS[@]}"); fi
 TRIPLE=x86_64-unknown-linux-gnu
 BIN_DIR=fuzz/target/$TRIPLE/release

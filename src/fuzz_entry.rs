@@ -48,6 +48,7 @@ pub const TARGETS: &[(&str, Entry)] = &[
     ("bag_sqlite", bag_sqlite),
     ("check_trajectory", check_trajectory),
     ("check_state_validity", check_state_validity),
+    ("srdf", srdf),
 ];
 
 /// Printed before a panic the library contained (mesh-loader), once per message.
@@ -231,6 +232,26 @@ fn robot_from_text(text: &str) {
 /// Checks a state from a fresh pipeline against the workcell.
 fn check_on_workcell(state: &RobotState) {
     let _ = workcell().check(state);
+}
+
+/// SRDF text (a `robot_semantic_file` or a `robot_description_semantic` message) parsed against
+/// the bundled arm, then everything the checker and `check_state_validity` ask of it: the pairs,
+/// the allowed collision matrix over every link pair, and every group's joints and links.
+pub fn srdf(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else { return };
+    let checker = workcell().checker();
+    let robot = checker.robot();
+    let Ok(model) = crate::model::Srdf::parse(text, "fuzz.srdf", robot) else { return };
+    for a in 0..robot.links.len() {
+        for b in 0..robot.links.len() {
+            let _ = model.is_disabled(a, b);
+        }
+    }
+    for name in model.group_names() {
+        let _ = model.group_joints(name, robot);
+        let _ = model.group_links(name, robot);
+    }
+    let _ = crate::checker::SelfPairs::build(checker, Some(model.clone()));
 }
 
 /// URDF text through `RobotModel::from_str`, then a checker and three states.
@@ -519,6 +540,23 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
 "#;
     out.push(("urdf", "shapes.urdf".into(), shapes.as_bytes().to_vec()));
 
+    // SRDF for the bundled arm: every element the parser reads, and some it reads past.
+    let srdf = r#"<?xml version="1.0"?>
+<robot name="workcell_arm">
+  <virtual_joint name="world_joint" type="fixed" parent_frame="world" child_link="base_link"/>
+  <group name="arm"><chain base_link="base_link" tip_link="gripper_link"/></group>
+  <group name="hand"><joint name="finger_left_joint"/><link name="finger_right_link"/></group>
+  <group name="all"><group name="arm"/><group name="hand"/><joint name="world_joint"/></group>
+  <group_state name="home" group="arm"><joint name="elbow_joint" value="0.3"/></group_state>
+  <end_effector name="gripper" parent_link="gripper_link" group="hand"/>
+  <disable_collisions link1="finger_left_link" link2="finger_right_link" reason="Adjacent"/>
+  <disable_default_collisions link="base_link"/>
+  <enable_collisions link1="base_link" link2="gripper_link"/>
+  <passive_joint name="tool0_joint"/>
+</robot>
+"#;
+    out.push(("srdf", "workcell_arm.srdf".into(), srdf.as_bytes().to_vec()));
+
     // Meshes: the workcell's OBJs (the small ones), the gripper as binary and ASCII STL, and a
     // COLLADA file with one triangle list.
     out.push(("mesh_obj", "gripper.obj".into(), read("gripper.obj")));
@@ -689,6 +727,16 @@ pub fn seeds() -> Vec<(&'static str, String, Vec<u8>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_srdf_seed_parses_against_the_bundled_arm() {
+        let seeds = seeds();
+        let (_, _, bytes) = seeds.iter().find(|(t, _, _)| *t == "srdf").expect("an srdf seed");
+        let text = std::str::from_utf8(bytes).unwrap();
+        let model = crate::model::Srdf::parse(text, "seed", workcell().checker().robot()).unwrap();
+        assert_eq!(model.group_names(), vec!["all", "arm", "hand"]);
+        srdf(bytes);
+    }
 
     #[test]
     fn trajectory_seeds_decode_and_reach_the_check() {

@@ -9,6 +9,7 @@ mod joint_state;
 mod motion;
 mod motion_sweep;
 mod self_collision;
+pub use self::self_collision::SelfPairs;
 mod state_report;
 mod world_motion;
 
