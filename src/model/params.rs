@@ -544,7 +544,9 @@ mod tests {
         assert_eq!(p.clearance_threshold, 0.0, "off unless asked for");
         let q = p.with_overrides(&[("clearance_threshold".into(), "0.05".into())]).unwrap();
         assert_eq!(q.clearance_threshold, 0.05);
-        let says = |e: String, what: &str| assert!(e.contains("clearance_threshold") && e.contains("must be from 0 (off) to 10 m") && !e.contains('\n'), "{what}: {e}");
+        let says = |e: String, what: &str| {
+            assert!(e.contains("clearance_threshold") && e.contains("must be from 0 (off) to 10 m") && !e.contains('\n'), "{what}: {e}")
+        };
         for v in ["-0.01", "11", "-1e-9"] {
             says(p.with_overrides(&[("clearance_threshold".into(), v.into())]).unwrap_err().to_string(), v);
         }
