@@ -1,6 +1,9 @@
 //! Shared by the integration tests that talk to the Python peers (coal, yourdfpy, rosbags, ...).
 #![allow(dead_code)]
 
+/// The Fast DDS peer (C++): built, started and driven (`tests/fastdds_interop.rs`, the two-host test).
+pub mod fastdds;
+
 use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;
 use std::process::{Child, ChildStdout, Command, Stdio};

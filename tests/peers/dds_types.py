@@ -77,6 +77,18 @@ GetReq = struct_typed("rcl_interfaces/srv/GetParameters_Request", [("names", t.s
 GetResp = struct_typed("rcl_interfaces/srv/GetParameters_Response", [("values", t.sequence[ParameterValue])])
 SetReq = struct_typed("rcl_interfaces/srv/SetParameters_Request", [("parameters", t.sequence[Parameter])])
 SetResp = struct_typed("rcl_interfaces/srv/SetParameters_Response", [("results", t.sequence[SetParametersResult])])
+# list_parameters and describe_parameters, as `ros2 param list` / `ros2 param describe` call them
+# (the Fast DDS peer, tests/peers/fastdds/peer.cpp, uses these through ros_idl.py).
+ListReq = struct_typed("rcl_interfaces/srv/ListParameters_Request", [("prefixes", t.sequence[str]), ("depth", t.uint64)])
+ListParametersResult = struct_typed("rcl_interfaces/msg/ListParametersResult", [("names", t.sequence[str]), ("prefixes", t.sequence[str])])
+ListResp = struct_typed("rcl_interfaces/srv/ListParameters_Response", [("result", ListParametersResult)])
+FloatingPointRange = struct_typed("rcl_interfaces/msg/FloatingPointRange", [("from_value", t.float64), ("to_value", t.float64), ("step", t.float64)])
+IntegerRange = struct_typed("rcl_interfaces/msg/IntegerRange", [("from_value", t.int64), ("to_value", t.int64), ("step", t.uint64)])
+ParameterDescriptor = struct_typed("rcl_interfaces/msg/ParameterDescriptor", [
+    ("name", str), ("type", t.uint8), ("description", str), ("additional_constraints", str), ("read_only", bool), ("dynamic_typing", bool),
+    ("floating_point_range", t.sequence[FloatingPointRange, 1]), ("integer_range", t.sequence[IntegerRange, 1])])
+DescribeReq = struct_typed("rcl_interfaces/srv/DescribeParameters_Request", [("names", t.sequence[str])])
+DescribeResp = struct_typed("rcl_interfaces/srv/DescribeParameters_Response", [("descriptors", t.sequence[ParameterDescriptor])])
 
 # visualization_msgs and diagnostic_msgs, to read the node's markers and status.
 ColorRGBA = struct_typed("std_msgs/msg/ColorRGBA", [("r", t.float32), ("g", t.float32), ("b", t.float32), ("a", t.float32)])

@@ -139,3 +139,10 @@ Constraints = TYPES["moveit_msgs/Constraints"]
 JointConstraint = TYPES["moveit_msgs/JointConstraint"]
 Request = TYPES["moveit_msgs/GetStateValidity_Request"]
 Response = TYPES["moveit_msgs/GetStateValidity_Response"]
+
+# The same service without Cyclone's header: the enhanced mapping (Fast DDS, rmw_fastrtps_cpp),
+# for the Fast DDS peer (tests/peers/fastdds/ros_idl.py takes this form where both exist).
+RequestEnhanced = struct_typed("moveit_msgs/srv/GetStateValidity_Request",
+                               [(n, a) for n, a in Request.__annotations__.items() if n not in ("guid", "seq")])
+ResponseEnhanced = struct_typed("moveit_msgs/srv/GetStateValidity_Response",
+                                [(n, a) for n, a in Response.__annotations__.items() if n not in ("guid", "seq")])
