@@ -1,0 +1,328 @@
+//! Issue 14, part 1: the node against an independent ROS 2 participant on eProsima Fast DDS, the
+//! default RMW of Humble and Jazzy (`tests/peers/fastdds/peer.cpp`, Debian's Fast DDS 2.9, types
+//! from the Python peers' field lists through fastddsgen `-typeros2`). The peer speaks as
+//! `rmw_fastrtps_cpp` does: topics `rt/...`, services `rq/<service>Request` and
+//! `rr/<service>Reply` with the request id carried as the sample identity (the node runs with
+//! `service_mapping:=enhanced`), and a client that accepts a reply only when its related sample
+//! identity names the client's reply reader (or request writer) and the request's sequence number.
+//! What is shown: joint states and `/tf` in, reports out equal to `check --json` on the same states
+//! (the node with `check_motion:=false`, one report per state); a latched `robot_description`
+//! published before the node starts is taken by it; `check_states`, `check_trajectory` and
+//! `check_state_validity` answered equal to `check`, several clients in flight at once, each
+//! answer correlated to its own request; the parameter services as `ros2 param` calls them (get,
+//! set, list, describe); the latched cell markers (a late joiner, as RViz is) and `/diagnostics`.
+//! Loopback only: the node with `ROS_LOCALHOST_ONLY=1`, the peer's UDPv4 transport on 127.0.0.1
+//! (no shared memory, no data sharing). Domains 160-162.
+
+mod common;
+
+use common::fastdds::{FastDdsPeer, PeerOptions};
+use common::start_node;
+use serde_json::{json, Value};
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdout, Command};
+
+const NAMES: [&str; 7] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
+
+/// A deterministic arm state (the same walk as `tests/ros_node.rs`): some collide, some do not.
+fn state(k: usize) -> Vec<f64> {
+    let x = k as f64;
+    vec![(0.37 * x).sin() * 1.5, 0.3 + (0.23 * x).cos() * 1.1, (0.11 * x).sin() * 1.6, 0.2 * x % 3.0, (0.5 * x).cos() * 1.5, 0.1 * x, 0.02]
+}
+
+fn state_json(k: usize, stamp: i64) -> Value {
+    json!({"name": NAMES, "position": state(k), "stamp": stamp})
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tc_fastdds_{name}_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `check --states FILE --json` (plus `extra`) on JSON lines; one report per line.
+fn check_cli(dir: &Path, name: &str, lines: &[Value], extra: &[&str]) -> Vec<Value> {
+    let file = dir.join(format!("{name}.jsonl"));
+    let text: Vec<String> = lines.iter().map(Value::to_string).collect();
+    std::fs::write(&file, text.join("\n") + "\n").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--states", file.to_str().unwrap(), "--json"]).args(extra).output().unwrap();
+    assert!(o.status.success(), "check: {}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+}
+
+fn close(a: &Value, b: &Value) -> bool {
+    match (a.as_f64(), b.as_f64()) {
+        (Some(x), Some(y)) => (x - y).abs() <= 1e-9,
+        _ => a.as_array().zip(b.as_array()).is_some_and(|(x, y)| x.len() == y.len() && x.iter().zip(y).all(|(p, q)| close(p, q))),
+    }
+}
+
+/// A report (topic or `check_states`) equals check's: collision, and each contact's link, object,
+/// triangle, depth, point and normal.
+fn assert_same_report(got: &Value, want: &Value, what: &str) {
+    assert_eq!(want["error"], "", "{what}: check could not check it: {want}");
+    assert_eq!((&got["in_collision"], &got["error"]), (&want["in_collision"], &json!("")), "{what}: {got} vs {want}");
+    let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
+    assert_eq!(g.len(), w.len(), "{what}: contacts {got} vs {want}");
+    for (a, b) in g.iter().zip(w) {
+        for k in ["link_name", "object_name", "triangle", "object_type"] {
+            assert_eq!(a[k], b[k], "{what}: {k}");
+        }
+        for k in ["depth", "position", "normal"] {
+            assert!(close(&a[k], &b[k]), "{what}: {k}: {a} vs {b}");
+        }
+    }
+}
+
+/// SIGTERM; the node must exit cleanly. Returns its remaining stdout and its stderr.
+fn stop(mut node: Child, mut out: std::io::BufReader<ChildStdout>) -> (String, String) {
+    let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
+    let status = node.wait().unwrap();
+    let (mut rest, mut err) = (String::new(), String::new());
+    let _ = out.read_to_string(&mut rest);
+    let _ = node.stderr.take().unwrap().read_to_string(&mut err);
+    assert!(status.success(), "node exit {status:?}: {err}");
+    (rest, err)
+}
+
+fn double(x: f64) -> Value {
+    json!({"type": 3, "double": x})
+}
+
+#[test]
+fn fastdds_topics_services_parameters_and_latched_markers() {
+    let t0 = std::time::Instant::now();
+    let dir = scratch("main");
+    let domain = 160;
+    let (node, out, banner) = start_node(&["--ros-args", "-r", "__node:=tc_fast", "-p", "check_motion:=false", "-p", "service_mapping:=enhanced"], domain);
+    assert!(banner.contains("/tc_fast") && banner.contains("loopback only"), "{banner}");
+    let mut peer = FastDdsPeer::start(&PeerOptions::loopback(domain));
+
+    // Joint states in (a reliable keep-last-10 writer, as joint_state_broadcaster offers them,
+    // matched by the node's best-effort reader), reports out.
+    let states: Vec<Value> = (0..25).map(|k| state_json(k, 1_000_000_000 + k as i64)).collect();
+    let reference = check_cli(&dir, "states", &states, &[]);
+    assert!(reference.iter().any(|r| r["in_collision"] == true) && reference.iter().any(|r| r["in_collision"] == false));
+    let a = peer.send(&json!({"cmd": "states", "states": states, "warm": {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}, "timeout": 30}));
+    assert_eq!(a["matched"], true, "no match on joint_states/collisions: {a}");
+    assert!(a["warm_reports"].as_u64().unwrap() >= 1, "the node never answered the warm-up state: {a}");
+    let reports = a["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), states.len(), "one report per state sent one at a time");
+    for (k, (got, want)) in reports.iter().zip(&reference).enumerate() {
+        assert_same_report(got, want, &format!("topic, state {k}"));
+        assert_eq!(got["stamp"].as_i64().unwrap(), 1_000_000_000 + k as i64, "stamped with the input's stamp");
+        assert_eq!((&got["frame_id"], &got["motion"]), (&json!("world"), &json!(false)));
+    }
+    eprintln!("topics: {} reports equal check ({:.1} s)", reports.len(), t0.elapsed().as_secs_f64());
+
+    // check_states from two clients at once: each gets the answer to its own request, the reply
+    // naming its reply reader's GUID and its request's sequence number, and refuses the other's.
+    let nan = json!({"name": ["elbow_joint", "wrist_1_joint"], "position": [0.1, "NaN"], "stamp": 8});
+    let q1 = json!({"states": [state_json(0, 7), state_json(1, 7), state_json(2, 7)]});
+    let q2 = json!({"states": [nan, state_json(3, 7), state_json(4, 7)]});
+    let answers = peer.call("check_states", "check_states", vec![q1, q2], 20.0);
+    let mut rejected = 0;
+    for (c, ans) in answers.iter().enumerate() {
+        assert_eq!(ans["reply_guid"], ans["reader_guid"], "client {c}: the reply names the client's reply reader, as rmw_fastrtps_cpp sets it: {ans}");
+        assert!(ans["reply_seq"].as_i64().unwrap() >= 1, "client {c}: {ans}");
+        rejected += ans["rejected"].as_u64().unwrap();
+    }
+    assert!(rejected >= 1, "each client's reader sees the other's reply and must refuse it: {answers:?}");
+    let r1 = answers[0]["response"]["reports"].as_array().unwrap_or_else(|| panic!("client 0 got no answer: {}", answers[0]));
+    let r2 = answers[1]["response"]["reports"].as_array().unwrap_or_else(|| panic!("client 1 got no answer: {}", answers[1]));
+    assert_eq!((r1.len(), r2.len()), (3, 3), "one report per state, in order");
+    for k in 0..3 {
+        assert_same_report(&r1[k], &reference[k], &format!("check_states client 0, state {k}"));
+    }
+    assert_eq!(r2[0]["in_collision"], true, "a NaN state fails closed: {}", r2[0]);
+    assert!(r2[0]["error"].as_str().unwrap().contains("non-finite"), "{}", r2[0]);
+    for k in 1..3 {
+        assert_same_report(&r2[k], &reference[k + 2], &format!("check_states client 1, state {}", k + 2));
+    }
+
+    // check_trajectory: answers equal check --motion on the same waypoints.
+    let trajectories: Vec<Vec<usize>> = vec![vec![0, 1, 2, 3, 4, 5], vec![6, 6], vec![10, 11, 12]];
+    let requests: Vec<Value> = trajectories
+        .iter()
+        .map(|t| json!({"joint_names": NAMES, "points": t.iter().enumerate().map(|(i, &k)| json!({"positions": state(k), "t": 1_000_000_000 * (i as i64 + 1)})).collect::<Vec<_>>()}))
+        .collect();
+    let answers = peer.call("check_trajectory", "check_trajectory", requests, 30.0);
+    let mut invalid = 0;
+    for (n, (t, ans)) in trajectories.iter().zip(&answers).enumerate() {
+        let got = &ans["response"];
+        assert!(got.is_object(), "trajectory {n}: no answer: {ans}");
+        let lines: Vec<Value> = t.iter().map(|&k| json!({"name": NAMES, "position": state(k)})).collect();
+        let cli = check_cli(&dir, &format!("trajectory{n}"), &lines, &["--motion"]);
+        assert_eq!(got["error"], "", "trajectory {n}: {got}");
+        match cli.iter().enumerate().skip(1).find(|(_, l)| l["in_collision"] == true) {
+            None => assert_eq!((&got["valid"], &got["segment"]), (&json!(true), &json!(-1)), "trajectory {n}: {got}"),
+            Some((line, want)) => {
+                invalid += 1;
+                assert_eq!((&got["valid"], got["segment"].as_i64()), (&json!(false), Some(line as i64 - 1)), "trajectory {n}: {got} vs {want}");
+                assert_eq!(got["fraction"].as_f64(), want["fraction"].as_f64(), "trajectory {n}");
+                let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
+                assert_eq!(g.len(), w.len(), "trajectory {n}");
+                for (a, b) in g.iter().zip(w) {
+                    assert_eq!((&a["link_name"], &a["object_name"]), (&b["link_name"], &b["object_name"]), "trajectory {n}");
+                    assert!(close(&a["depth"], &b["depth"]), "trajectory {n}: depth");
+                }
+            }
+        }
+    }
+    assert!(invalid >= 1 && invalid < trajectories.len(), "the trajectories cover valid and invalid answers ({invalid} invalid)");
+
+    // check_state_validity (moveit_msgs/srv/GetStateValidity), six clients in flight at once.
+    let picks = [0usize, 1, 2, 3, 4, 5];
+    let requests: Vec<Value> = picks.iter().map(|&k| json!({"name": NAMES, "position": state(k), "group_name": ""})).collect();
+    let answers = peer.call("check_state_validity", "check_state_validity", requests, 20.0);
+    for (&k, ans) in picks.iter().zip(&answers) {
+        let got = &ans["response"];
+        let want = &reference[k];
+        assert!(got.is_object(), "state {k}: no answer: {ans}");
+        assert_eq!(got["valid"], json!(want["in_collision"] == false), "state {k}: {got} vs {want}");
+        let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
+        assert_eq!(g.len(), w.len(), "state {k}: {got}");
+        for (a, b) in g.iter().zip(w) {
+            assert_eq!((&a["body_1"], &a["body_2"], &a["type_1"]), (&b["link_name"], &b["object_name"], &json!(0)), "state {k}");
+            assert!(close(&a["depth"], &b["depth"]) && close(&a["position"], &b["position"]) && close(&a["normal"], &b["normal"]), "state {k}");
+        }
+    }
+    eprintln!("services answered ({:.1} s)", t0.elapsed().as_secs_f64());
+
+    // The parameter services, as `ros2 param get/set/list/describe` call them.
+    let get = |peer: &mut FastDdsPeer, names: &[&str]| -> Vec<Value> {
+        let a = peer.call("tc_fast/get_parameters", "get_parameters", vec![json!({"names": names})], 20.0);
+        a[0]["response"]["values"].as_array().cloned().unwrap_or_else(|| panic!("get_parameters: no answer: {}", a[0]))
+    };
+    let set = |peer: &mut FastDdsPeer, name: &str, value: Value| -> Value {
+        let a = peer.call("tc_fast/set_parameters", "set_parameters", vec![json!({"parameters": [{"name": name, "value": value}]})], 20.0);
+        a[0]["response"]["results"][0].clone()
+    };
+    let before = get(&mut peer, &["default_thickness", "world_frame", "no_such_parameter"]);
+    assert_eq!((&before[0]["type"], &before[0]["double"]), (&json!(3), &json!(0.02)), "{before:?}");
+    assert_eq!((&before[1]["type"], &before[1]["string"]), (&json!(4), &json!("world")), "{before:?}");
+    assert_eq!(before[2]["type"], 0, "an unknown name is NOT_SET: {before:?}");
+    let refused = set(&mut peer, "default_thickness", double(-1.0));
+    assert_eq!(refused["successful"], false, "a negative thickness is refused: {refused}");
+    assert!(!refused["reason"].as_str().unwrap_or_default().is_empty(), "with a reason: {refused}");
+    let read_only = set(&mut peer, "service_mapping", json!({"type": 4, "string": "cyclone"}));
+    assert_eq!(read_only["successful"], false, "service_mapping is read-only while the node runs: {read_only}");
+    let accepted = set(&mut peer, "default_thickness", double(0.03));
+    assert_eq!(accepted["successful"], true, "{accepted}");
+    let after = get(&mut peer, &["default_thickness", "service_mapping"]);
+    assert_eq!((&after[0]["double"], &after[1]["string"]), (&json!(0.03), &json!("enhanced")), "{after:?}");
+    let listed = peer.call("tc_fast/list_parameters", "list_parameters", vec![json!({"prefixes": [], "depth": 0})], 20.0);
+    let names: Vec<&str> = listed[0]["response"]["names"].as_array().unwrap_or_else(|| panic!("list_parameters: {}", listed[0])).iter().filter_map(Value::as_str).collect();
+    for n in ["default_thickness", "world_frame", "check_motion", "service_mapping", "padding.values", "use_sim_time"] {
+        assert!(names.contains(&n), "list_parameters lacks {n}: {names:?}");
+    }
+    assert!(listed[0]["response"]["prefixes"].as_array().unwrap().contains(&json!("padding")), "{}", listed[0]);
+    let described = peer.call("tc_fast/describe_parameters", "describe_parameters", vec![json!({"names": ["default_thickness", "world_frame", "check_motion"]})], 20.0);
+    let d = described[0]["response"]["descriptors"].as_array().unwrap_or_else(|| panic!("describe_parameters: {}", described[0]));
+    let types: Vec<(&Value, &Value)> = d.iter().map(|x| (&x["name"], &x["type"])).collect();
+    assert_eq!(types, vec![(&json!("default_thickness"), &json!(3)), (&json!("world_frame"), &json!(4)), (&json!("check_motion"), &json!(1))]);
+    eprintln!("parameter services answered ({:.1} s)", t0.elapsed().as_secs_f64());
+
+    // The latched cells, read by a reader created now (a late joiner, as RViz is), and the status.
+    let t_latched = std::time::Instant::now();
+    let a = peer.send(&json!({"cmd": "latched", "timeout": 60}));
+    let cells = a["cells"].as_array().unwrap_or_else(|| panic!("no cell markers within 60 s: {a}"));
+    assert_eq!(cells.len(), 3, "one triangle list per thin surface: {a}");
+    assert!(cells.iter().all(|m| m["type"] == 11 && m["frame"] == "world"), "{a}");
+    let triangles: u64 = cells.iter().map(|m| m["points"].as_u64().unwrap() / 3).sum();
+    assert_eq!(triangles, 8 * 4112, "8 triangles per cell, every cell of the workcell (under marker_max_cells)");
+    eprintln!("latched cells: {} triangles after {:.1} s (2.4 MB; issue 14 part 4 is about this time)", triangles, a["cells_seconds"].as_f64().unwrap_or(-1.0));
+    let status = &a["diagnostics"][0];
+    assert_eq!(status["name"], "/tc_fast: collision checks", "{a}");
+    let received: u64 = status["values"]["states_received"].as_str().and_then(|v| v.parse().ok()).unwrap_or(0);
+    assert!(received >= 26, "states_received counts the states sent ({received}): {status}");
+    for key in ["input_rate_hz", "states_checked", "states_skipped", "check_seconds_mean"] {
+        assert!(status["values"][key].is_string(), "diagnostics lack {key}: {status}");
+    }
+    eprintln!("latched markers and /diagnostics ({:.1} s)", t_latched.elapsed().as_secs_f64());
+
+    peer.quit();
+    let (_rest, err) = stop(node, out);
+    assert!(err.contains("non-finite") || err.contains("failed closed"), "the NaN state was warned about: {err}");
+    eprintln!("total {:.1} s", t0.elapsed().as_secs_f64());
+}
+
+#[test]
+fn fastdds_tf_input_equals_check_with_transforms() {
+    use thickness_collision::checker::Checker;
+    use thickness_collision::math::pose_from_isometry;
+    use thickness_collision::model::Params;
+    let dir = scratch("tf");
+    let domain = 161;
+    let (node, out, banner) = start_node(&["--ros-args", "-p", "check_motion:=false", "-p", "pose_source:=tf", "-p", "service_mapping:=enhanced"], domain);
+    assert!(banner.contains("/tf"), "{banner}");
+    let mut peer = FastDdsPeer::start(&PeerOptions::loopback(domain));
+
+    // Link poses from forward kinematics, sent as world -> <link> transforms on /tf.
+    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let (mut tf_states, mut lines) = (Vec::new(), Vec::new());
+    for k in 0..12 {
+        let mut q = vec![0.0; checker.robot().joints.len()];
+        for (n, p) in NAMES.iter().zip(state(k)) {
+            q[checker.robot().joint(n).unwrap()] = p;
+        }
+        let poses = checker.robot().forward_kinematics(&q, &nalgebra::Isometry3::identity()).unwrap();
+        let (mut tfs, mut line) = (Vec::new(), Vec::new());
+        for t in checker.targets() {
+            let p = pose_from_isometry(&poses[t.link]);
+            let r = [p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w];
+            tfs.push(json!({"parent": "world", "child": t.name, "translation": p.translation.to_array(), "rotation": r}));
+            line.push(json!({"link": t.name, "translation": p.translation.to_array(), "rotation": r}));
+        }
+        tf_states.push(json!({"stamp": 2_000_000_000 + k, "transforms": tfs}));
+        lines.push(json!({"transforms": line}));
+    }
+    let reference = check_cli(&dir, "tf", &lines, &[]);
+    assert!(reference.iter().any(|r| r["in_collision"] == true) && reference.iter().any(|r| r["in_collision"] == false));
+    let mut warm = tf_states[0].clone();
+    warm["stamp"] = json!(1);
+    let a = peer.send(&json!({"cmd": "states", "input": "tf", "states": tf_states, "warm": warm, "timeout": 30}));
+    assert_eq!(a["matched"], true, "no match on /tf or collisions: {a}");
+    let reports = a["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), reference.len(), "one report per /tf message: {a}");
+    for (k, (got, want)) in reports.iter().zip(&reference).enumerate() {
+        assert_same_report(got, want, &format!("tf state {k}"));
+        assert_eq!(got["stamp"].as_i64().unwrap(), 2_000_000_000 + k as i64);
+    }
+    peer.quit();
+    let _ = stop(node, out);
+}
+
+#[test]
+fn fastdds_latched_robot_description_is_taken_by_a_node_started_after_it() {
+    let dir = scratch("desc");
+    let domain = 162;
+    let urdf = common::fat_arm_urdf();
+    let fat = dir.join("fat_arm.urdf");
+    std::fs::write(&fat, &urdf).unwrap();
+    let states: Vec<Value> = (0..15).map(|k| state_json(k, k as i64 + 10)).collect();
+    let thin = check_cli(&dir, "thin", &states, &[]);
+    let fat_ref = check_cli(&dir, "fat", &states, &["--robot", fat.to_str().unwrap()]);
+    let colliding = |v: &[Value]| v.iter().filter(|r| r["in_collision"] == true).count();
+    assert!(colliding(&fat_ref) > colliding(&thin), "the fat forearm must collide more often");
+
+    // The description first, latched (as robot_state_publisher offers it); the node afterwards.
+    let mut peer = FastDdsPeer::start(&PeerOptions::loopback(domain));
+    assert_eq!(peer.send(&json!({"cmd": "description", "text": urdf}))["ok"], true);
+    let (node, out, _banner) = start_node(&["--ros-args", "-p", "check_motion:=false"], domain);
+    // The reports below are the fat arm's only if the node built it from the topic; the warm-up
+    // waits for the node's readers, and a state is answered only after the description's turn.
+    let a = peer.send(&json!({"cmd": "states", "states": states, "warm": {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}, "timeout": 30}));
+    assert_eq!(a["matched"], true, "{a}");
+    let readers = peer.send(&json!({"cmd": "status"}))["description_readers"].as_u64().unwrap();
+    assert!(readers >= 1, "the node's robot_description reader matched the latched writer");
+    let reports = a["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), fat_ref.len(), "{a}");
+    for (k, (got, want)) in reports.iter().zip(&fat_ref).enumerate() {
+        assert_same_report(got, want, &format!("state {k}: the node must check the fat arm from the latched topic"));
+    }
+    peer.quit();
+    let (rest, err) = stop(node, out);
+    assert!(rest.contains("robot from robot_description"), "stdout: {rest}\nstderr: {err}");
+}
