@@ -213,12 +213,14 @@ fn fastdds_topics_services_parameters_and_latched_markers() {
     let after = get(&mut peer, &["default_thickness", "service_mapping"]);
     assert_eq!((&after[0]["double"], &after[1]["string"]), (&json!(0.03), &json!("enhanced")), "{after:?}");
     let listed = peer.call("tc_fast/list_parameters", "list_parameters", vec![json!({"prefixes": [], "depth": 0})], 20.0);
-    let names: Vec<&str> = listed[0]["response"]["names"].as_array().unwrap_or_else(|| panic!("list_parameters: {}", listed[0])).iter().filter_map(Value::as_str).collect();
+    let names: Vec<&str> =
+        listed[0]["response"]["names"].as_array().unwrap_or_else(|| panic!("list_parameters: {}", listed[0])).iter().filter_map(Value::as_str).collect();
     for n in ["default_thickness", "world_frame", "check_motion", "service_mapping", "padding.values", "use_sim_time"] {
         assert!(names.contains(&n), "list_parameters lacks {n}: {names:?}");
     }
     assert!(listed[0]["response"]["prefixes"].as_array().unwrap().contains(&json!("padding")), "{}", listed[0]);
-    let described = peer.call("tc_fast/describe_parameters", "describe_parameters", vec![json!({"names": ["default_thickness", "world_frame", "check_motion"]})], 20.0);
+    let described =
+        peer.call("tc_fast/describe_parameters", "describe_parameters", vec![json!({"names": ["default_thickness", "world_frame", "check_motion"]})], 20.0);
     let d = described[0]["response"]["descriptors"].as_array().unwrap_or_else(|| panic!("describe_parameters: {}", described[0]));
     let types: Vec<(&Value, &Value)> = d.iter().map(|x| (&x["name"], &x["type"])).collect();
     assert_eq!(types, vec![(&json!("default_thickness"), &json!(3)), (&json!("world_frame"), &json!(4)), (&json!("check_motion"), &json!(1))]);
@@ -325,4 +327,50 @@ fn fastdds_latched_robot_description_is_taken_by_a_node_started_after_it() {
     peer.quit();
     let (rest, err) = stop(node, out);
     assert!(rest.contains("robot from robot_description"), "stdout: {rest}\nstderr: {err}");
+}
+
+/// The parameter services follow `service_mapping`: with `cyclone` they are reached as `ros2 param`
+/// on `rmw_cyclonedds_cpp` reaches them (ros2-client serves them with the enhanced mapping only;
+/// the node serves them itself with the others: `src/ros/param_services.rs`). Cyclone DDS from
+/// Python (`tests/peers/param_peer.py`), Cyclone's request/reply mapping.
+#[test]
+fn parameter_services_follow_service_mapping_cyclone() {
+    use std::io::Write;
+    use std::process::Stdio;
+    let dir = scratch("params_cyclone");
+    let cyclone = dir.join("cyclone.xml");
+    std::fs::write(&cyclone, common::CYCLONE_LOOPBACK).unwrap();
+    let domain = 163;
+    let (node, out, _banner) = start_node(&["--ros-args", "-r", "__node:=tc_cy", "-p", "service_mapping:=cyclone"], domain);
+    let calls = json!([
+        {"service": "get_parameters", "request": {"names": ["default_thickness", "world_frame", "no_such_parameter"]}},
+        {"service": "set_parameters", "request": {"name": "default_thickness", "double": -1.0}},
+        {"service": "set_parameters", "request": {"name": "default_thickness", "double": 0.05}},
+        {"service": "get_parameters", "request": {"names": ["default_thickness"]}},
+        {"service": "list_parameters", "request": {"prefixes": ["padding"], "depth": 0}},
+        {"service": "describe_parameters", "request": {"names": ["default_thickness", "service_mapping", "no_such_parameter"]}},
+    ]);
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/param_peer.py");
+    let mut child = Command::new(common::python())
+        .arg(&script)
+        .env("CYCLONEDDS_URI", format!("file://{}", cyclone.display()))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(json!({"domain": domain, "node": "tc_cy", "calls": calls, "timeout": 20}).to_string().as_bytes()).unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success(), "param_peer.py: {}", String::from_utf8_lossy(&o.stderr));
+    let a: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let answers = a["answers"].as_array().unwrap();
+    assert!(answers.iter().all(Value::is_object), "every call answered over the Cyclone mapping: {a}");
+    assert_eq!(answers[0]["values"], json!([[3, 0.02, ""], [4, 0.0, "world"], [0, 0.0, ""]]), "{a}");
+    assert_eq!(answers[1]["results"][0][0], false, "a negative thickness is refused: {a}");
+    assert_eq!(answers[2]["results"][0], json!([true, ""]), "{a}");
+    assert_eq!(answers[3]["values"][0][1], json!(0.05), "{a}");
+    assert_eq!(answers[4], json!({"names": ["padding.links", "padding.values"], "prefixes": ["padding"]}), "{a}");
+    assert_eq!(answers[5], json!({"types": [3, 4, 0], "read_only": [false, true, true]}), "{a}");
+    let (rest, _err) = stop(node, out);
+    assert!(rest.contains("parameters changed"), "the accepted set reached the node's loop: {rest}");
 }

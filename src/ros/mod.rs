@@ -8,6 +8,7 @@
 mod markers;
 mod msg_impls;
 mod node_run;
+mod param_services;
 mod param_values;
 mod ros_args;
 mod validity_worker;

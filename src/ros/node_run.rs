@@ -7,6 +7,7 @@
 
 use super::markers::{cell_markers, contact_markers, diagnostics, NodeStats};
 use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
+use super::param_services::{ros_mapping, ParamRequest, ParamRequests, ParamServers};
 use super::param_values::{declarations, to_json, READ_ONLY};
 use super::ros_args::RosArgs;
 use super::validity_worker::{ValidityWorker, MAX_VALIDITY_PENDING};
@@ -281,7 +282,9 @@ fn parameter_options(params: &Params, changes: smol::channel::Sender<Params>) ->
         *current = fresh;
         Ok(())
     };
-    let mut options = NodeOptions::new().enable_rosout(true).start_parameter_services(true);
+    // ros2-client serves the parameter services with the enhanced mapping only; with another the
+    // node serves them itself (param_services.rs).
+    let mut options = NodeOptions::new().enable_rosout(true).start_parameter_services(params.service_mapping == ServiceMapping::Enhanced);
     for (name, value) in declarations(params) {
         options = options.declare_parameter(&name, value);
     }
@@ -304,6 +307,8 @@ enum Event {
     ValidityRequest(ros2_client::service::RmwRequestId, Box<GetStateValidityRequest>),
     /// The worker checked a state: the answer to send, and why the request was not honoured.
     ValidityDone(ros2_client::service::RmwRequestId, GetStateValidityResponse, Option<String>),
+    /// A parameter service request (served here with the basic and cyclone mappings).
+    Parameter(ParamRequest),
     /// A sample that could not be read (on the topic or service named).
     ReadFailed(&'static str, ReadError),
     Tick,
@@ -697,6 +702,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         )
         .map_err(|e| anyhow!("cannot create the node: {e:?}"))?;
     let io = Interfaces::build(&mut node, pipeline.params(), &opts.ros_args)?;
+    let param_servers = ParamServers::build(&mut node, ros_mapping(pipeline.params().service_mapping))?;
 
     {
         let s = pipeline.checker().summary();
@@ -785,6 +791,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let mut checked_trajectories = Box::pin(worker.done.clone());
         let mut validity_requests = io.check_state_validity.receive_request_stream();
         let mut checked_validity = Box::pin(validity_worker.done.clone());
+        let mut param_requests: ParamRequests = param_servers.as_ref().map_or_else(|| Box::pin(futures::stream::pending()), ParamServers::requests);
         while !stop.load(Ordering::SeqCst) {
             state.on_tick(&node, &io);
             let tick = FutureExt::fuse(smol::Timer::after(Duration::from_millis(100)));
@@ -801,6 +808,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 (id, answer) = checked_trajectories.select_next_some() => Event::TrajectoryDone(id, answer),
                 r = validity_requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_state_validity", e), |(id, req)| Event::ValidityRequest(id, Box::new(req))),
                 (id, answer, reason) = checked_validity.select_next_some() => Event::ValidityDone(id, answer, reason),
+                r = param_requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("parameter services", e), Event::Parameter),
                 _ = tick => Event::Tick,
             };
             // A parameter change accepted before this input arrived applies to it.
@@ -818,6 +826,13 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 Event::ValidityRequest(id, req) => state.on_validity_request(&io, &validity_worker, id, req).await,
                 Event::ValidityDone(id, answer, reason) => state.send_validity_answer(&io, id, answer, reason).await,
                 Event::ReadFailed(what, e) => state.on_read_failed(what, &e),
+                Event::Parameter(r) => {
+                    if let Some(p) = &param_servers {
+                        if let Err(what) = p.answer(&node, r).await {
+                            state.log.warn("service-send", || format!("sending a {what} response failed"));
+                        }
+                    }
+                }
                 Event::Tick => {}
             }
         }
