@@ -492,7 +492,7 @@ impl Checker {
         }
         // Every colliding self pair, in flag-only checks too (which links collide must not
         // depend on the mode; a pair costs a bounding-ball test when apart).
-        report.contacts.extend(self.self_contacts(world, false));
+        report.contacts.extend(self.self_contacts(world));
         report.in_collision = !report.contacts.is_empty();
         report
     }

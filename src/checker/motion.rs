@@ -97,11 +97,6 @@ pub(super) fn grow(shape: &TargetShape, pad: Real) -> TargetShape {
 
 impl MotionBounds {
     pub(crate) fn new(robot: &RobotModel, targets: &[LinkTargets], tolerance: Real) -> MotionBounds {
-        // The joint whose child each link is.
-        let mut parent_joint = vec![None; robot.links.len()];
-        for (j, joint) in robot.joints.iter().enumerate() {
-            parent_joint[joint.child] = Some(j);
-        }
         let mut levers = Vec::with_capacity(targets.len());
         let mut reaches = Vec::with_capacity(targets.len());
         for t in targets {
@@ -113,7 +108,7 @@ impl MotionBounds {
             let mut list = Vec::new();
             let mut link = t.link;
             let mut steps = 0;
-            while let Some(j) = parent_joint[link] {
+            while let Some(j) = robot.parent_joint(link) {
                 let joint = &robot.joints[j];
                 match joint.kind {
                     JointKind::Revolute | JointKind::Continuous => list.push((j, chain + reach)),

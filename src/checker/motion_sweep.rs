@@ -4,7 +4,7 @@
 //! cannot be cleared.
 
 use super::checker_build::Checker;
-use super::motion::{grow, MotionReport, MAX_SUBINTERVALS};
+use super::motion::{grow, MotionBounds, MotionReport, MAX_SUBINTERVALS};
 use super::state_report::{ObjectType, ReportContact, StateReport};
 use crate::collision::{collide_pair, CollideSettings, PairContact, Target, TargetShape};
 use crate::math::{Pose, Real};
@@ -55,127 +55,132 @@ struct Blocked {
     other: Option<(usize, Option<usize>, Pose)>,
 }
 
+/// What the test of one stretch found.
+enum Stretch {
+    /// Nothing can be met on it.
+    Clear,
+    /// Not cleared at this size: try its halves.
+    Split,
+    /// Not cleared and not worth splitting: the motion is blocked from the stretch's start.
+    Blocked(Blocked),
+}
+
+/// The ladder level that covers a displacement bound, and whether it is worth testing with: the
+/// growth covers the bound (rounding, NaN or past the ladder's top: split) and is not beyond what
+/// is worth testing (the first rung always is). A target that does not move is tested as it is.
+fn rung(bounds: &MotionBounds, delta: Real) -> (Option<usize>, bool) {
+    if delta > 0.0 {
+        let level = bounds.level(delta);
+        let growth = bounds.growth(level);
+        (Some(level), growth >= delta && (growth <= MAX_TESTED_GROWTH || level == 0))
+    } else {
+        (None, true)
+    }
+}
+
+/// The state of one sweep: the link poses by `s` (the targets of one link chain meet at the same
+/// midpoints), the earliest stretch blocked so far, and the stretches examined.
+struct Sweep {
+    poses_at: HashMap<u64, Vec<Option<Pose>>>,
+    blocked: Option<Blocked>,
+    examined: u64,
+    stack: Vec<(f64, f64)>,
+}
+
+impl Sweep {
+    /// Clears `[0, limit)` by bisection, left half first, where `limit` is the earliest stretch
+    /// blocked so far; `test` judges a stretch from the link poses at its middle, its start and
+    /// its half-width.
+    fn clear(&mut self, path: &impl MotionPath, mut test: impl FnMut(&[Option<Pose>], f64, f64) -> Result<Stretch, String>) -> Result<(), String> {
+        self.stack.clear();
+        self.stack.push((0.0, 1.0));
+        while let Some((a, b)) = self.stack.pop() {
+            let limit = self.blocked.as_ref().map_or(f64::INFINITY, |b| b.fraction);
+            if a >= limit {
+                continue;
+            }
+            self.examined += 1;
+            if self.examined > MAX_SUBINTERVALS {
+                return Err(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"));
+            }
+            let m = 0.5 * (a + b);
+            if self.poses_at.len() >= MAX_CACHED_POSES {
+                self.poses_at.clear();
+            }
+            let poses = match self.poses_at.entry(m.to_bits()) {
+                Entry::Occupied(e) => e.into_mut(),
+                Entry::Vacant(e) => e.insert(path.link_poses(m)?),
+            };
+            match test(poses, a, 0.5 * (b - a))? {
+                Stretch::Clear => {}
+                Stretch::Split => {
+                    self.stack.push((m, b));
+                    self.stack.push((a, m));
+                }
+                Stretch::Blocked(blocked) => {
+                    self.blocked = Some(blocked);
+                    return Ok(());
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 impl Checker {
-    /// The adaptive loop over `path` (see the module documentation of `motion`). Targets are
-    /// cleared one after the other, each over `[0, limit)`, where `limit` is the earliest stretch
-    /// that an earlier target could not clear: the answer is the earliest over all targets, as if
-    /// they were examined together, left half first.
+    /// The adaptive loop over `path` (see the module documentation of `motion`). Targets, then
+    /// self pairs, are cleared one after the other, each over `[0, limit)`, where `limit` is the
+    /// earliest stretch that an earlier one could not clear: the answer is the earliest over all,
+    /// as if they were examined together, left half first.
     pub(super) fn sweep_motion(&self, path: &impl MotionPath) -> MotionReport {
         let bounds = self.motion_bounds();
         let speed = path.speeds();
         let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
-        let failed = |error: String, examined: u64| {
+        let mut sweep = Sweep { poses_at: HashMap::new(), blocked: None, examined: 0, stack: Vec::with_capacity(64) };
+        let mut run = || -> Result<(), String> {
+            for (ti, lt) in self.targets().iter().enumerate() {
+                sweep.clear(path, |poses, a, half| {
+                    let pose = poses[lt.link].ok_or_else(|| format!("no pose for link '{}'", lt.name))?;
+                    // A link that does not move is where it is at every s: checked as it is,
+                    // ungrown (a base resting on a table is not a near miss).
+                    let (level, tested) = if speed[ti] > 0.0 { rung(bounds, path.bound(ti, poses, half)) } else { (None, true) };
+                    Ok(if tested && !self.grown_link_hit(ti, level, &pose, &flags) {
+                        Stretch::Clear
+                    } else if level.is_none_or(|l| l == 0) {
+                        Stretch::Blocked(Blocked { fraction: a, ti, level, pose, other: None })
+                    } else {
+                        Stretch::Split
+                    })
+                })?;
+            }
+            // A pair is cleared on a stretch when its two links at the middle, each grown by its
+            // own displacement bound, do not meet (then they stay apart all along the stretch).
+            for &(ta, tb) in &self.self_pairs().pairs {
+                let (la, lb) = (&self.targets()[ta], &self.targets()[tb]);
+                sweep.clear(path, |poses, a, half| {
+                    let (Some(pa), Some(pb)) = (poses[la.link], poses[lb.link]) else {
+                        return Err(format!("no pose for link '{}' or '{}'", la.name, lb.name));
+                    };
+                    let (delta_a, delta_b) = path.pair_bound(ta, tb, poses, half);
+                    let ((level_a, tested_a), (level_b, tested_b)) = (rung(bounds, delta_a), rung(bounds, delta_b));
+                    Ok(if tested_a && tested_b && self.grown_pair_contact(ta, level_a, &pa, tb, level_b, &pb).is_none() {
+                        Stretch::Clear
+                    } else if level_a.is_none_or(|l| l == 0) && level_b.is_none_or(|l| l == 0) {
+                        Stretch::Blocked(Blocked { fraction: a, ti: ta, level: level_a, pose: pa, other: Some((tb, level_b, pb)) })
+                    } else {
+                        Stretch::Split
+                    })
+                })?;
+            }
+            Ok(())
+        };
+        if let Err(error) = run() {
             let mut report = StateReport::failed(error);
             report.motion = true;
-            MotionReport { report, fraction: None, subintervals: examined }
-        };
-        // Link poses by `s`: the targets of one link chain meet at the same midpoints.
-        let mut poses_at: HashMap<u64, Vec<Option<Pose>>> = HashMap::new();
-        let mut blocked: Option<Blocked> = None;
-        let mut examined = 0u64;
-        let mut stack: Vec<(f64, f64)> = Vec::with_capacity(64);
-        for (ti, lt) in self.targets().iter().enumerate() {
-            stack.clear();
-            stack.push((0.0, 1.0));
-            while let Some((a, b)) = stack.pop() {
-                let limit = blocked.as_ref().map_or(f64::INFINITY, |b| b.fraction);
-                if a >= limit {
-                    continue;
-                }
-                examined += 1;
-                if examined > MAX_SUBINTERVALS {
-                    return failed(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"), examined);
-                }
-                let m = 0.5 * (a + b);
-                if poses_at.len() >= MAX_CACHED_POSES {
-                    poses_at.clear();
-                }
-                let poses = match poses_at.entry(m.to_bits()) {
-                    Entry::Occupied(e) => e.into_mut(),
-                    Entry::Vacant(e) => match path.link_poses(m) {
-                        Ok(p) => e.insert(p),
-                        Err(error) => return failed(error, examined),
-                    },
-                };
-                let Some(link_pose) = poses[lt.link] else {
-                    return failed(format!("no pose for link '{}'", lt.name), examined);
-                };
-                // A link that does not move is where it is at every s: checked as it is, ungrown
-                // (a base resting on a table is not a near miss).
-                // Tested only when the growth covers the bound (rounding, NaN or past the ladder's
-                // top: split) and is not beyond what is worth testing (the first rung always is).
-                let (level, tested) = if speed[ti] > 0.0 {
-                    let delta = path.bound(ti, poses, 0.5 * (b - a));
-                    let level = bounds.level(delta);
-                    let growth = bounds.growth(level);
-                    (Some(level), growth >= delta && (growth <= MAX_TESTED_GROWTH || level == 0))
-                } else {
-                    (None, true)
-                };
-                if tested && !self.grown_link_hit(ti, level, &link_pose, &flags) {
-                    continue;
-                }
-                if level.is_none_or(|l| l == 0) {
-                    blocked = Some(Blocked { fraction: a, ti, level, pose: link_pose, other: None });
-                    break;
-                }
-                stack.push((m, b));
-                stack.push((a, m));
-            }
+            return MotionReport { report, fraction: None, subintervals: sweep.examined };
         }
-        // Self pairs: a pair is cleared on a stretch when its two links at the middle, each grown
-        // by its own displacement bound, do not meet (then they stay apart by more than the sum
-        // of the bounds' worth of motion).
-        for &(ta, tb) in &self.self_pairs().pairs {
-            let (la, lb) = (self.targets()[ta].link, self.targets()[tb].link);
-            stack.clear();
-            stack.push((0.0, 1.0));
-            while let Some((a, b)) = stack.pop() {
-                let limit = blocked.as_ref().map_or(f64::INFINITY, |b| b.fraction);
-                if a >= limit {
-                    continue;
-                }
-                examined += 1;
-                if examined > MAX_SUBINTERVALS {
-                    return failed(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"), examined);
-                }
-                let m = 0.5 * (a + b);
-                if poses_at.len() >= MAX_CACHED_POSES {
-                    poses_at.clear();
-                }
-                let poses = match poses_at.entry(m.to_bits()) {
-                    Entry::Occupied(e) => e.into_mut(),
-                    Entry::Vacant(e) => match path.link_poses(m) {
-                        Ok(p) => e.insert(p),
-                        Err(error) => return failed(error, examined),
-                    },
-                };
-                let (Some(pa), Some(pb)) = (poses[la], poses[lb]) else {
-                    return failed(format!("no pose for link '{}' or '{}'", self.targets()[ta].name, self.targets()[tb].name), examined);
-                };
-                let (delta_a, delta_b) = path.pair_bound(ta, tb, poses, 0.5 * (b - a));
-                let step = |delta: Real| -> (Option<usize>, bool) {
-                    if delta > 0.0 {
-                        let level = bounds.level(delta);
-                        let growth = bounds.growth(level);
-                        (Some(level), growth >= delta && (growth <= MAX_TESTED_GROWTH || level == 0))
-                    } else {
-                        (None, true)
-                    }
-                };
-                let ((level_a, tested_a), (level_b, tested_b)) = (step(delta_a), step(delta_b));
-                if tested_a && tested_b && self.grown_pair_contact(ta, level_a, &pa, tb, level_b, &pb).is_none() {
-                    continue;
-                }
-                if level_a.is_none_or(|l| l == 0) && level_b.is_none_or(|l| l == 0) {
-                    blocked = Some(Blocked { fraction: a, ti: ta, level: level_a, pose: pa, other: Some((tb, level_b, pb)) });
-                    break;
-                }
-                stack.push((m, b));
-                stack.push((a, m));
-            }
-        }
-        match blocked {
+        let examined = sweep.examined;
+        match sweep.blocked {
             None => {
                 // A free motion stands for its end pose: the clearances are that pose's.
                 let clearances = if self.params().clearance_threshold > 0.0 { path.report_at(1.0).clearances } else { Vec::new() };

@@ -161,8 +161,8 @@ impl SelfPairs {
 impl Checker {
     /// One contact per colliding self pair at the given world poses: `link_name` the pair's first
     /// link in model order, `object_name` the other, `normal` pushing `link_name` out, `depth`
-    /// the least overlap of its deepest pair of parts. With `first_only`, stops at the first.
-    pub(crate) fn self_contacts(&self, world: &[Option<Pose>], first_only: bool) -> Vec<ReportContact> {
+    /// the least overlap of its deepest pair of parts.
+    pub(crate) fn self_contacts(&self, world: &[Option<Pose>]) -> Vec<ReportContact> {
         let targets = self.targets();
         let mut out = Vec::new();
         for &(a, b) in &self.self_pairs().pairs {
@@ -176,9 +176,6 @@ impl Checker {
                     normal: c.normal.to_array(),
                     object_type: ObjectType::RobotLink,
                 });
-                if first_only {
-                    break;
-                }
             }
         }
         out

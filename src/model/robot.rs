@@ -195,6 +195,8 @@ pub struct RobotModel {
     pub root: usize,
     /// Joints in an order where every joint's parent link is placed before it.
     order: Vec<usize>,
+    /// Per link: the joint whose child it is (none for the root).
+    parent_joint: Vec<Option<usize>>,
     link_index: HashMap<String, usize>,
     joint_index: HashMap<String, usize>,
 }
@@ -462,7 +464,16 @@ impl RobotModel {
                 }
             }
         }
-        Ok(RobotModel { name: urdf.name, links, joints, root, order, link_index, joint_index })
+        let mut parent_joint = vec![None; links.len()];
+        for (j, joint) in joints.iter().enumerate() {
+            parent_joint[joint.child] = Some(j);
+        }
+        Ok(RobotModel { name: urdf.name, links, joints, root, order, parent_joint, link_index, joint_index })
+    }
+
+    /// The joint whose child link `link` is; `None` for the root (or an index out of range).
+    pub fn parent_joint(&self, link: usize) -> Option<usize> {
+        self.parent_joint.get(link).copied().flatten()
     }
 
     /// Index of a link by name.

@@ -165,10 +165,6 @@ impl Srdf {
     /// list, each once, so a cycle in the file ends.
     pub fn group_joints(&self, name: &str, robot: &RobotModel) -> Option<Vec<usize>> {
         let _ = self.groups.get(name)?;
-        let mut parent_joint = vec![None; robot.links.len()];
-        for (j, joint) in robot.joints.iter().enumerate() {
-            parent_joint[joint.child] = Some(j);
-        }
         let mut joints = BTreeSet::new();
         let mut seen = BTreeSet::new();
         let mut work = vec![name.to_owned()];
@@ -178,7 +174,7 @@ impl Srdf {
             }
             let Some(spec) = self.groups.get(&g) else { continue };
             joints.extend(spec.joints.iter().copied());
-            joints.extend(spec.links.iter().filter_map(|&l| parent_joint[l]));
+            joints.extend(spec.links.iter().filter_map(|&l| robot.parent_joint(l)));
             for &(base, tip) in &spec.chains {
                 // Up from the tip to the base; a tip not below the base adds nothing.
                 let mut chain = Vec::new();
@@ -189,7 +185,7 @@ impl Srdf {
                         found = true;
                         break;
                     }
-                    let Some(j) = parent_joint[link] else { break };
+                    let Some(j) = robot.parent_joint(link) else { break };
                     chain.push(j);
                     link = robot.joints[j].parent;
                 }

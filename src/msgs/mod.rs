@@ -6,6 +6,7 @@
 //! `interfaces/thickness_collision_msgs/msg/*.msg`; `tests/msgs_interface.rs` checks the field
 //! order, and the replay tests read what `replay` writes back with rosbags.
 
+mod bounded;
 mod definitions;
 pub mod moveit;
 
@@ -20,29 +21,7 @@ pub const MAX_JOINT_STATE_ENTRIES: usize = 65_536;
 
 /// A sequence of at most [`MAX_JOINT_STATE_ENTRIES`], refused as soon as it runs past.
 fn bounded_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
-    struct Bounded<T>(std::marker::PhantomData<T>);
-    impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Bounded<T> {
-        type Value = Vec<T>;
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            write!(f, "a sequence of at most {MAX_JOINT_STATE_ENTRIES} entries")
-        }
-        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<T>, A::Error> {
-            if let Some(n) = seq.size_hint().filter(|n| *n > MAX_JOINT_STATE_ENTRIES) {
-                return Err(serde::de::Error::custom(format!("a joint state field of {n} entries; at most {MAX_JOINT_STATE_ENTRIES} allowed")));
-            }
-            let mut out = Vec::with_capacity(seq.size_hint().unwrap_or(0).min(1024));
-            while let Some(x) = seq.next_element()? {
-                if out.len() == MAX_JOINT_STATE_ENTRIES {
-                    return Err(serde::de::Error::custom(format!(
-                        "a joint state field of more than {MAX_JOINT_STATE_ENTRIES} entries; at most {MAX_JOINT_STATE_ENTRIES} allowed"
-                    )));
-                }
-                out.push(x);
-            }
-            Ok(out)
-        }
-    }
-    d.deserialize_seq(Bounded(std::marker::PhantomData))
+    bounded::bounded_vec(d, MAX_JOINT_STATE_ENTRIES, "joint state field")
 }
 
 /// `builtin_interfaces/msg/Time`.
@@ -376,28 +355,7 @@ pub const MAX_TRAJECTORY_ENTRIES: usize = 65_536;
 
 /// A trajectory sequence of at most [`MAX_TRAJECTORY_ENTRIES`], refused as soon as it runs past.
 fn bounded_trajectory_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
-    struct Bounded<T>(std::marker::PhantomData<T>);
-    impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Bounded<T> {
-        type Value = Vec<T>;
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            write!(f, "a sequence of at most {MAX_TRAJECTORY_ENTRIES} entries")
-        }
-        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<T>, A::Error> {
-            let too_long = |n: &str| serde::de::Error::custom(format!("a trajectory field of {n} entries; at most {MAX_TRAJECTORY_ENTRIES} allowed"));
-            if let Some(n) = seq.size_hint().filter(|n| *n > MAX_TRAJECTORY_ENTRIES) {
-                return Err(too_long(&n.to_string()));
-            }
-            let mut out = Vec::with_capacity(seq.size_hint().unwrap_or(0).min(1024));
-            while let Some(x) = seq.next_element()? {
-                if out.len() == MAX_TRAJECTORY_ENTRIES {
-                    return Err(too_long(&format!("more than {MAX_TRAJECTORY_ENTRIES}")));
-                }
-                out.push(x);
-            }
-            Ok(out)
-        }
-    }
-    d.deserialize_seq(Bounded(std::marker::PhantomData))
+    bounded::bounded_vec(d, MAX_TRAJECTORY_ENTRIES, "trajectory field")
 }
 
 /// `trajectory_msgs/msg/JointTrajectoryPoint`.

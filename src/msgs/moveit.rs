@@ -18,28 +18,7 @@ pub const MAX_MOVEIT_ENTRIES: usize = 65_536;
 
 /// A sequence of at most [`MAX_MOVEIT_ENTRIES`], refused as soon as it runs past.
 fn bounded<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
-    struct Bounded<T>(std::marker::PhantomData<T>);
-    impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Bounded<T> {
-        type Value = Vec<T>;
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            write!(f, "a sequence of at most {MAX_MOVEIT_ENTRIES} entries")
-        }
-        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<T>, A::Error> {
-            let too_long = |n: &str| serde::de::Error::custom(format!("a GetStateValidity sequence of {n} entries; at most {MAX_MOVEIT_ENTRIES} allowed"));
-            if let Some(n) = seq.size_hint().filter(|n| *n > MAX_MOVEIT_ENTRIES) {
-                return Err(too_long(&n.to_string()));
-            }
-            let mut out = Vec::with_capacity(seq.size_hint().unwrap_or(0).min(1024));
-            while let Some(x) = seq.next_element()? {
-                if out.len() == MAX_MOVEIT_ENTRIES {
-                    return Err(too_long(&format!("more than {MAX_MOVEIT_ENTRIES}")));
-                }
-                out.push(x);
-            }
-            Ok(out)
-        }
-    }
-    d.deserialize_seq(Bounded(std::marker::PhantomData))
+    super::bounded::bounded_vec(d, MAX_MOVEIT_ENTRIES, "GetStateValidity sequence")
 }
 
 /// `float64[<=3]`: a bounded sequence of at most 3 on the wire, refused past that.
