@@ -1,0 +1,373 @@
+// The latency instrument (issue 14, parts 3 and 4), on Fast DDS 2.9, UDPv4 on 127.0.0.1 only:
+// built-in transports off, no shared memory, no data sharing (the node's path: RustDDS on UDP).
+//
+//   latency measure  DOMAIN SECONDS WARMUP_S RATE_HZ...   JointState out, CollisionReport in; JSON per rate
+//   latency relay    DOMAIN                               answers each state with an empty report
+//   latency latejoin DOMAIN TOPIC (markers|string) TIMEOUT_S   a late reader of a latched topic; JSON
+//   latency latched  DOMAIN TOPIC BYTES SECONDS            publishes one latched std_msgs/String
+//
+// Built with tests/peers/fastdds/build.sh (benches/run_latency.sh does it). QoS as
+// rmw_fastrtps_cpp makes them for what the node asks: joint_states best effort, keep last 100
+// (the node's reader; a sensor stream), collisions reliable, volatile, keep last 100, synchronous
+// publication, history memory preallocated with realloc; latched topics reliable, transient local,
+// keep last 1.
+//
+// measure: a sender thread publishes at RATE_HZ, sleeping with clock_nanosleep(TIMER_ABSTIME) to
+// SPIN_NS before each deadline and spinning for the rest (2 cores: a sleeping sender leaves the
+// other core to the node). The stamp of each state is its send time (CLOCK_REALTIME, taken just
+// before write()); a report is matched to the state by its stamp, and latency is the report's
+// receive time (CLOCK_REALTIME, in the listener) minus that stamp. "answered" counts states whose
+// own stamp came back; with check_motion the node may cover several states waiting together with
+// one report stamped with the newest: "covered" counts states at or before a stamp that came back.
+#include "ros.h"
+#include "rosPubSubTypes.h"
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <string>
+#include <thread>
+#include <vector>
+
+using namespace eprosima::fastdds::dds;
+using eprosima::fastrtps::rtps::Locator_t;
+
+namespace {
+
+constexpr int64_t SPIN_NS = 50'000;
+
+int64_t now_ns(clockid_t clock) {
+    timespec ts{};
+    clock_gettime(clock, &ts);
+    return int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// A participant on UDPv4 bound to 127.0.0.1, discovering by unicast to 127.0.0.1 (loopback has no
+// multicast in a private namespace; the node's RustDDS answers unicast SPDP).
+DomainParticipant* participant(int domain, const char* name) {
+    DomainParticipantQos qos;
+    qos.name(name);
+    qos.transport().use_builtin_transports = false;
+    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    udp->interfaceWhiteList.emplace_back("127.0.0.1");
+    qos.transport().user_transports.push_back(udp);
+    Locator_t peer;
+    peer.kind = LOCATOR_KIND_UDPv4;
+    eprosima::fastrtps::rtps::IPLocator::setIPv4(peer, 127, 0, 0, 1);
+    qos.wire_protocol().builtin.initialPeersList.push_back(peer);
+    qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0, 500'000'000);
+    auto* p = DomainParticipantFactory::get_instance()->create_participant(domain, qos);
+    if (p == nullptr) {
+        std::fprintf(stderr, "latency: cannot create the participant on domain %d\n", domain);
+        std::exit(1);
+    }
+    return p;
+}
+
+DataWriterQos writer_qos(const DataWriterQos& base, bool reliable, bool latched, int depth) {
+    DataWriterQos q = base;
+    q.reliability().kind = reliable ? RELIABLE_RELIABILITY_QOS : BEST_EFFORT_RELIABILITY_QOS;
+    q.durability().kind = latched ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
+    q.history().kind = KEEP_LAST_HISTORY_QOS;
+    q.history().depth = depth;
+    q.publish_mode().kind = SYNCHRONOUS_PUBLISH_MODE;
+    q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+    q.data_sharing().off();
+    return q;
+}
+
+DataReaderQos reader_qos(const DataReaderQos& base, bool reliable, bool latched, int depth) {
+    DataReaderQos q = base;
+    q.reliability().kind = reliable ? RELIABLE_RELIABILITY_QOS : BEST_EFFORT_RELIABILITY_QOS;
+    q.durability().kind = latched ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
+    q.history().kind = KEEP_LAST_HISTORY_QOS;
+    q.history().depth = depth;
+    q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+    q.data_sharing().off();
+    return q;
+}
+
+Topic* topic(DomainParticipant* p, const char* name, TopicDataType* type) {
+    TypeSupport ts(type);
+    ts.register_type(p);
+    return p->create_topic(name, ts.get_type_name(), TOPIC_QOS_DEFAULT);
+}
+
+// ---- relay ----
+
+struct RelayListener : DataReaderListener {
+    DataWriter* writer = nullptr;
+    sensor_msgs::msg::JointState state;
+    thickness_collision_msgs::msg::CollisionReport report;
+    void on_data_available(DataReader* reader) override {
+        SampleInfo info;
+        while (reader->take_next_sample(&state, &info) == ReturnCode_t::RETCODE_OK) {
+            if (!info.valid_data) continue;
+            report.header().stamp() = state.header().stamp();
+            report.header().frame_id("world");
+            writer->write(&report);
+        }
+    }
+};
+
+int relay(int domain) {
+    auto* p = participant(domain, "latency_relay_cpp");
+    auto* states = topic(p, "rt/joint_states", new sensor_msgs::msg::JointStatePubSubType());
+    auto* reports = topic(p, "rt/collisions", new thickness_collision_msgs::msg::CollisionReportPubSubType());
+    auto* pub = p->create_publisher(PUBLISHER_QOS_DEFAULT);
+    auto* sub = p->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+    static RelayListener listener;
+    listener.writer = pub->create_datawriter(reports, writer_qos(pub->get_default_datawriter_qos(), true, false, 100));
+    sub->create_datareader(states, reader_qos(sub->get_default_datareader_qos(), false, false, 100), &listener);
+    std::printf("relay ready\n");
+    std::fflush(stdout);
+    for (;;) std::this_thread::sleep_for(std::chrono::seconds(3600));
+}
+
+// ---- measure ----
+
+struct Received {
+    int64_t stamp;
+    int64_t at;
+};
+
+struct MeasureListener : DataReaderListener {
+    std::vector<Received> got;
+    std::atomic<size_t> n{0};
+    std::atomic<int> matched{0};
+    thickness_collision_msgs::msg::CollisionReport report;
+    void on_data_available(DataReader* reader) override {
+        SampleInfo info;
+        while (reader->take_next_sample(&report, &info) == ReturnCode_t::RETCODE_OK) {
+            int64_t at = now_ns(CLOCK_REALTIME);
+            if (!info.valid_data) continue;
+            size_t i = n.load(std::memory_order_relaxed);
+            if (i < got.size()) {  // past the end only if reports outnumber states twice
+                got[i] = {int64_t(report.header().stamp().sec()) * 1'000'000'000 + report.header().stamp().nanosec(), at};
+                n.store(i + 1, std::memory_order_release);
+            }
+        }
+    }
+    void on_subscription_matched(DataReader*, const SubscriptionMatchedStatus& s) override { matched = s.current_count; }
+};
+
+struct WriterMatch : DataWriterListener {
+    std::atomic<int> matched{0};
+    void on_publication_matched(DataWriter*, const PublicationMatchedStatus& s) override { matched = s.current_count; }
+};
+
+double pct(const std::vector<double>& sorted, double q) {
+    if (sorted.empty()) return -1;
+    size_t i = size_t(std::ceil(q * double(sorted.size()))) ;
+    return sorted[std::min(sorted.size() - 1, i == 0 ? 0 : i - 1)];
+}
+
+// One run at `rate` on matched endpoints; prints one JSON line.
+void run_rate(DataWriter* writer, MeasureListener& listener, double rate, double seconds, double warmup);
+
+int measure(int domain, const std::vector<double>& rates, double seconds, double warmup) {
+    auto* p = participant(domain, "latency_measure");
+    auto* states = topic(p, "rt/joint_states", new sensor_msgs::msg::JointStatePubSubType());
+    auto* reports = topic(p, "rt/collisions", new thickness_collision_msgs::msg::CollisionReportPubSubType());
+    auto* pub = p->create_publisher(PUBLISHER_QOS_DEFAULT);
+    auto* sub = p->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+    static WriterMatch wmatch;
+    // A sensor stream as rmw_fastrtps_cpp offers SensorDataQoS: best effort, keep last 5.
+    auto* writer = pub->create_datawriter(states, writer_qos(pub->get_default_datawriter_qos(), false, false, 5), &wmatch);
+    static MeasureListener listener;
+    double most = 0;
+    for (double r : rates) most = std::max(most, r);
+    listener.got.resize(size_t(most * (seconds + warmup) * 2) + 1000);
+    sub->create_datareader(reports, reader_qos(sub->get_default_datareader_qos(), true, false, 1000), &listener);
+    int64_t t0 = now_ns(CLOCK_MONOTONIC);
+    while (wmatch.matched == 0 || listener.matched == 0) {
+        if (now_ns(CLOCK_MONOTONIC) - t0 > 30'000'000'000) {
+            std::fprintf(stderr, "latency: no match within 30 s (writer %d, reader %d)\n", wmatch.matched.load(), listener.matched.load());
+            return 1;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    for (double rate : rates) {
+        run_rate(writer, listener, rate, seconds, warmup);
+    }
+    // A clean exit: the peers learn at once that this participant's reader is gone (a reliable
+    // writer matched to a reader that vanished without a word waits for it until its lease ends).
+    p->delete_contained_entities();
+    DomainParticipantFactory::get_instance()->delete_participant(p);
+    return 0;
+}
+
+void run_rate(DataWriter* writer, MeasureListener& listener, double rate, double seconds, double warmup) {
+    const size_t warm = size_t(rate * warmup), total = warm + size_t(rate * seconds);
+    listener.n.store(0, std::memory_order_release);  // got holds room for the largest run
+    // The bundled workcell's arm, moving slowly through free space (a motion for check_motion).
+    sensor_msgs::msg::JointState js;
+    js.header().frame_id("");
+    js.name({"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint",
+             "finger_left_joint", "finger_right_joint"});
+    js.position().assign(8, 0.0);
+    std::vector<int64_t> sent(total);
+    const int64_t period = int64_t(1e9 / rate);
+    int64_t deadline = now_ns(CLOCK_MONOTONIC) + period;
+    size_t late = 0;
+    int64_t worst_late = 0;
+    for (size_t i = 0; i < total; ++i) {
+        int64_t wake = deadline - SPIN_NS;
+        timespec ts{time_t(wake / 1'000'000'000), long(wake % 1'000'000'000)};
+        while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
+        int64_t m;
+        while ((m = now_ns(CLOCK_MONOTONIC)) < deadline) {}
+        if (m - deadline > period) {
+            ++late;
+        }
+        worst_late = std::max(worst_late, m - deadline);
+        double t = double(i) / rate;
+        js.position()[0] = 0.3 * std::sin(2 * M_PI * 0.25 * t);
+        js.position()[1] = -0.5 + 0.2 * std::sin(2 * M_PI * 0.2 * t);
+        js.position()[2] = 0.8 + 0.2 * std::sin(2 * M_PI * 0.3 * t);
+        js.position()[5] = 0.5 * t;
+        int64_t stamp = now_ns(CLOCK_REALTIME);
+        js.header().stamp().sec(int32_t(stamp / 1'000'000'000));
+        js.header().stamp().nanosec(uint32_t(stamp % 1'000'000'000));
+        sent[i] = stamp;
+        writer->write(&js);
+        deadline += period;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+
+    size_t n = listener.n.load(std::memory_order_acquire);
+    std::vector<Received> got(listener.got.begin(), listener.got.begin() + n);
+    std::sort(got.begin(), got.end(), [](const Received& a, const Received& b) { return a.stamp < b.stamp; });
+    std::vector<double> lat;
+    size_t answered = 0, covered = 0, j = 0;
+    int64_t newest = got.empty() ? INT64_MIN : got.back().stamp;
+    for (size_t i = warm; i < total; ++i) {
+        while (j < got.size() && got[j].stamp < sent[i]) ++j;
+        if (j < got.size() && got[j].stamp == sent[i]) {
+            ++answered;
+            lat.push_back(double(got[j].at - sent[i]) / 1e3);
+        }
+        if (sent[i] <= newest) ++covered;
+    }
+    std::sort(lat.begin(), lat.end());
+    size_t measured = total - warm;
+    std::printf(
+        "{\"rate\": %.0f, \"sent\": %zu, \"answered\": %zu, \"covered\": %zu, \"median_us\": %.1f, \"p99_us\": %.1f, "
+        "\"p999_us\": %.1f, \"max_us\": %.1f, \"late_sends\": %zu, \"worst_send_lateness_us\": %.1f, \"warmup_states\": %zu}\n",
+        rate, measured, answered, covered, pct(lat, 0.5), pct(lat, 0.99), pct(lat, 0.999), lat.empty() ? -1.0 : lat.back(), late,
+        double(worst_late) / 1e3, warm);
+    std::fflush(stdout);
+}
+
+// ---- late joiner and latched publisher (large messages) ----
+
+struct LateListener : DataReaderListener {
+    std::atomic<int64_t> at{0};
+    std::atomic<int64_t> matched_at{0};
+    std::atomic<int> matched{0};
+    TopicDataType* type = nullptr;
+    std::string summary;
+    bool markers = false;
+    void on_data_available(DataReader* reader) override {
+        SampleInfo info;
+        if (markers) {
+            visualization_msgs::msg::MarkerArray m;
+            while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+                if (!info.valid_data || at != 0) continue;
+                size_t points = 0;
+                for (auto& k : m.markers()) points += k.points().size();
+                summary = "\"markers\": " + std::to_string(m.markers().size()) + ", \"points\": " + std::to_string(points) +
+                          ", \"bytes\": " + std::to_string(type->getSerializedSizeProvider(&m)());
+                at = now_ns(CLOCK_MONOTONIC);
+            }
+        } else {
+            std_msgs::msg::String s;
+            while (reader->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
+                if (!info.valid_data || at != 0) continue;
+                summary = "\"bytes\": " + std::to_string(s.data().size());
+                at = now_ns(CLOCK_MONOTONIC);
+            }
+        }
+    }
+    void on_subscription_matched(DataReader*, const SubscriptionMatchedStatus& s) override {
+        if (s.current_count > 0 && matched_at == 0) matched_at = now_ns(CLOCK_MONOTONIC);
+        matched = s.current_count;
+    }
+};
+
+int latejoin(int domain, const char* name, bool markers, double timeout) {
+    int64_t t0 = now_ns(CLOCK_MONOTONIC);
+    auto* p = participant(domain, "latency_latejoin");
+    TopicDataType* type = markers ? static_cast<TopicDataType*>(new visualization_msgs::msg::MarkerArrayPubSubType())
+                                  : static_cast<TopicDataType*>(new std_msgs::msg::StringPubSubType());
+    auto* t = topic(p, name, type);
+    auto* sub = p->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+    static LateListener listener;
+    listener.type = type;
+    listener.markers = markers;
+    sub->create_datareader(t, reader_qos(sub->get_default_datareader_qos(), true, true, 1), &listener);
+    while (listener.at == 0 && now_ns(CLOCK_MONOTONIC) - t0 < int64_t(timeout * 1e9)) {
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    int64_t at = listener.at, m = listener.matched_at;
+    if (at == 0) {
+        std::printf("{\"topic\": \"%s\", \"received\": false, \"matched_ms\": %.1f}\n", name, m ? double(m - t0) / 1e6 : NAN);
+    } else {
+        std::printf("{\"topic\": \"%s\", \"received\": true, \"matched_ms\": %.1f, \"received_ms\": %.1f, \"after_match_ms\": %.1f, %s}\n", name,
+                    double(m - t0) / 1e6, double(at - t0) / 1e6, double(at - m) / 1e6, listener.summary.c_str());
+    }
+    std::fflush(stdout);
+    std::_Exit(at == 0 ? 3 : 0);
+}
+
+int latched(int domain, const char* name, size_t bytes, double seconds) {
+    auto* p = participant(domain, "latency_latched");
+    auto* t = topic(p, name, new std_msgs::msg::StringPubSubType());
+    auto* pub = p->create_publisher(PUBLISHER_QOS_DEFAULT);
+    auto* w = pub->create_datawriter(t, writer_qos(pub->get_default_datawriter_qos(), true, true, 1));
+    std_msgs::msg::String s;
+    std::string text = "<?xml version=\"1.0\"?>\n<!-- padding -->\n";
+    text.resize(bytes, ' ');
+    s.data(text);
+    w->write(&s);
+    std::printf("published %zu bytes\n", bytes);
+    std::fflush(stdout);
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+    std::_Exit(0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::string mode = argc > 1 ? argv[1] : "";
+    if (mode == "relay" && argc == 3) return relay(std::atoi(argv[2]));
+    if (mode == "measure" && argc >= 6) {
+        std::vector<double> rates;
+        for (int i = 5; i < argc; ++i) rates.push_back(std::atof(argv[i]));
+        return measure(std::atoi(argv[2]), rates, std::atof(argv[3]), std::atof(argv[4]));
+    }
+    if (mode == "latejoin" && argc == 6) return latejoin(std::atoi(argv[2]), argv[3], std::strcmp(argv[4], "markers") == 0, std::atof(argv[5]));
+    if (mode == "latched" && argc == 6) return latched(std::atoi(argv[2]), argv[3], size_t(std::atoll(argv[4])), std::atof(argv[5]));
+    std::fprintf(stderr,
+                 "usage: latency measure DOMAIN SECONDS WARMUP_S RATE_HZ... | relay DOMAIN | latejoin DOMAIN TOPIC markers|string TIMEOUT_S"
+                 " | latched DOMAIN TOPIC BYTES SECONDS\n");
+    return 2;
+}
