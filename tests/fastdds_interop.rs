@@ -374,3 +374,30 @@ fn parameter_services_follow_service_mapping_cyclone() {
     let (rest, _err) = stop(node, out);
     assert!(rest.contains("parameters changed"), "the accepted set reached the node's loop: {rest}");
 }
+
+/// Jazzy's Fast DDS (2.14) writes a request's related sample identity as PID 0x0083 (Humble's 2.9:
+/// 0x800f), and cannot be installed here: the peer sends that form itself (its chaining transport
+/// rewrites the PID in each outgoing DATA submessage; `pid_stats` counts the rewrites). The node
+/// must read the identity from 0x0083: its reply names the client's reply reader, which only that
+/// parameter carries. The control, a PID the node does not know (0x7123), shows the assertion can
+/// fail: without the identity the node names the request writer (a reply rmw_fastrtps_cpp still
+/// accepts, so the call is answered either way).
+#[test]
+fn fastdds_jazzy_related_sample_identity_pid_0x0083() {
+    let domain = 164;
+    let (node, out, _banner) = start_node(&["--ros-args", "-p", "check_motion:=false", "-p", "service_mapping:=enhanced"], domain);
+    let request = || vec![json!({"states": [state_json(3, 5)]})];
+    for (pid, names_reader) in [("0x0083", true), ("0x7123", false)] {
+        let mut opts = PeerOptions::loopback(domain);
+        opts.env.push(("TC_FASTDDS_RELATED_SAMPLE_IDENTITY_PID".into(), pid.into()));
+        let mut peer = FastDdsPeer::start(&opts);
+        let answers = peer.call("check_states", "check_states", request(), 20.0);
+        let a = &answers[0];
+        assert_eq!(a["response"]["reports"].as_array().map(Vec::len), Some(1), "PID {pid}: check_states answered: {a}");
+        let rewritten = peer.send(&json!({"cmd": "pid_stats"}))["rewritten"].as_u64().unwrap();
+        assert!(rewritten >= 1, "PID {pid}: the request went out with the rewritten PID ({rewritten} rewrites)");
+        assert_eq!(a["reply_guid"] == a["reader_guid"], names_reader, "PID {pid}: the reply names the reply reader only when the node read the identity: {a}");
+        peer.quit();
+    }
+    let _ = stop(node, out);
+}

@@ -7,7 +7,8 @@
 //
 // Transport: UDPv4 only (built-in transports off: no shared memory), on the interface given with
 // --interface (127.0.0.1 unless told otherwise), initial peers --peer (127.0.0.1 unless told), no
-// data sharing. Domain: --domain, else ROS_DOMAIN_ID.
+// data sharing. Domain: --domain, else ROS_DOMAIN_ID. The PID of the related sample identity:
+// --related-sample-identity-pid, else TC_FASTDDS_RELATED_SAMPLE_IDENTITY_PID, else 0x800f (see below).
 //
 // The client does what rmw_fastrtps_cpp's client does (rmw_fastrtps_shared_cpp, rmw_request.cpp and
 // custom_client_info.hpp): it writes each request with WriteParams whose
@@ -29,6 +30,8 @@
 //       one client (writer + reader) per request, all in flight together;
 //       -> {"answers":[{"response":...|null,"attempts":n,"rejected":n,"reply_guid":g,"reply_seq":n}]}
 //   {"cmd":"latched","ns":"","timeout":s} -> {"cells":[...]|null,"diagnostics":[...]|null}
+//   {"cmd":"pid_stats"} -> {"rewritten":n}: related sample identities sent under another PID than
+//       0x800f (--related-sample-identity-pid 0x0083, Jazzy's; see PidRewriteTransport)
 //   {"cmd":"quit"}
 #include "peer_json.hpp"
 #include "ros.h"
@@ -44,11 +47,17 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fastdds/rtps/common/WriteParams.h>
+#include <fastdds/rtps/network/SenderResource.h>
+#include <fastdds/rtps/transport/ChainingTransport.h>
+#include <fastdds/rtps/transport/ChainingTransportDescriptor.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -208,17 +217,88 @@ DataReaderQos reader_qos(const Qos& q) {
 // rmw_qos_profile_services_default: reliable, volatile, keep last 10.
 const Qos kServiceQos{true, false, 10};
 
+// ---- Jazzy's related sample identity ---------------------------------------------------------
+//
+// Fast DDS 2.9 (Humble) writes the related sample identity of a request as PID 0x800f
+// (PID_CUSTOM_RELATED_SAMPLE_IDENTITY); Fast DDS 2.14 (Jazzy) writes the standard PID 0x0083 (DDS-RPC
+// 7.8.2). Jazzy's Fast DDS cannot be installed here, so with --related-sample-identity-pid 0x0083 the
+// peer sends that form itself: a chaining transport over UDPv4 rewrites, in every outgoing RTPS DATA
+// submessage, the inline QoS parameter 0x800f to 0x0083 (same length and value). Only 0x0083 is
+// then on the wire, which is stricter than Jazzy (it writes both).
+
+std::atomic<uint64_t> g_rewritten{0};
+// The PID the related sample identity is sent as: 0x800f (Fast DDS 2.9, no rewriting), 0x0083 (Jazzy),
+// or another (a control: a PID the node does not know).
+uint16_t g_pid = 0x800f;
+
+// Rewrites PID `from` to `to` in the inline QoS of the DATA submessages of one RTPS message.
+void rewrite_pid(std::vector<rtps::octet>& m, uint16_t from, uint16_t to) {
+    if (m.size() < 20 || std::memcmp(m.data(), "RTPS", 4) != 0) return;
+    size_t at = 20;  // after the RTPS header
+    while (at + 4 <= m.size()) {
+        uint8_t id = m[at], flags = m[at + 1];
+        bool le = flags & 0x01;
+        auto u16 = [&](size_t i) -> uint16_t { return le ? uint16_t(m[i] | (m[i + 1] << 8)) : uint16_t((m[i] << 8) | m[i + 1]); };
+        size_t body = at + 4;
+        size_t length = u16(at + 2);
+        size_t end = length == 0 ? m.size() : std::min(m.size(), body + length);
+        if (id == 0x15 && (flags & 0x02) && body + 4 <= end) {  // DATA with inline QoS
+            size_t q = body + 4 + u16(body + 2);  // after extraFlags, octetsToInlineQos and what it skips
+            while (q + 4 <= end) {
+                uint16_t pid = u16(q), plen = u16(q + 2);
+                if (pid == 0x0001) break;  // PID_SENTINEL
+                if (pid == from) {
+                    m[q] = le ? uint8_t(to & 0xff) : uint8_t(to >> 8);
+                    m[q + 1] = le ? uint8_t(to >> 8) : uint8_t(to & 0xff);
+                    ++g_rewritten;
+                }
+                q += 4 + plen;
+            }
+        }
+        if (length == 0) break;
+        at = body + length;
+    }
+}
+
+struct PidRewriteDescriptor : public eprosima::fastdds::rtps::ChainingTransportDescriptor {
+    explicit PidRewriteDescriptor(std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface> low);
+    eprosima::fastdds::rtps::TransportInterface* create_transport() const override;
+};
+
+class PidRewriteTransport : public eprosima::fastdds::rtps::ChainingTransport {
+public:
+    explicit PidRewriteTransport(const PidRewriteDescriptor& d) : ChainingTransport(d), descriptor_(d) {}
+    eprosima::fastdds::rtps::TransportDescriptorInterface* get_configuration() override { return &descriptor_; }
+    bool send(rtps::SenderResource* low, const rtps::octet* buffer, uint32_t size, rtps::LocatorsIterator* begin, rtps::LocatorsIterator* end,
+              const std::chrono::steady_clock::time_point& timeout) override {
+        std::vector<rtps::octet> copy(buffer, buffer + size);
+        rewrite_pid(copy, 0x800f, g_pid);
+        return low->send(copy.data(), size, begin, end, timeout);
+    }
+    void receive(eprosima::fastdds::rtps::TransportReceiverInterface* next, const rtps::octet* buffer, uint32_t size, const rtps::Locator_t& local,
+                 const rtps::Locator_t& remote) override {
+        next->OnDataReceived(buffer, size, local, remote);
+    }
+
+private:
+    PidRewriteDescriptor descriptor_;
+};
+
+PidRewriteDescriptor::PidRewriteDescriptor(std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface> low) : ChainingTransportDescriptor(low) {}
+eprosima::fastdds::rtps::TransportInterface* PidRewriteDescriptor::create_transport() const { return new PidRewriteTransport(*this); }
+
 // ---- the participant -------------------------------------------------------------------------
 
 class Peer {
 public:
-    Peer(int domain, const std::string& interface, const std::vector<std::string>& peers) : domain_(domain) {
+    Peer(int domain, const std::string& interface, const std::vector<std::string>& peers, bool rewrite) : domain_(domain) {
         DomainParticipantQos pq = PARTICIPANT_QOS_DEFAULT;
         pq.name("tc_fastdds_peer");
         pq.transport().use_builtin_transports = false;
         auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
         udp->interfaceWhiteList.push_back(interface);
-        pq.transport().user_transports.push_back(udp);
+        if (rewrite) pq.transport().user_transports.push_back(std::make_shared<PidRewriteDescriptor>(udp));
+        else pq.transport().user_transports.push_back(udp);
         // Initial peers: the well-known metatraffic unicast ports of participants 0..19 on each
         // peer address (port = 7400 + 250 domain + 10 + 2 id), as Fast DDS expands a port-less peer.
         for (const auto& address : peers) {
@@ -694,6 +774,7 @@ std::string cmd_call(Peer& peer, const pj::Value& cmd) {
 int main(int argc, char** argv) {
     int domain = 0;
     if (const char* d = std::getenv("ROS_DOMAIN_ID")) domain = std::atoi(d);
+    if (const char* pid = std::getenv("TC_FASTDDS_RELATED_SAMPLE_IDENTITY_PID")) g_pid = static_cast<uint16_t>(std::stoul(pid, nullptr, 16));
     std::string interface = "127.0.0.1";
     std::vector<std::string> peers;
     for (int i = 1; i + 1 < argc; i += 2) {
@@ -701,14 +782,15 @@ int main(int argc, char** argv) {
         if (a == "--domain") domain = std::atoi(argv[i + 1]);
         else if (a == "--interface") interface = argv[i + 1];
         else if (a == "--peer") peers.push_back(argv[i + 1]);
+        else if (a == "--related-sample-identity-pid") g_pid = static_cast<uint16_t>(std::stoul(argv[i + 1], nullptr, 16));
         else {
-            std::cerr << "usage: peer [--domain N] [--interface ADDRESS] [--peer ADDRESS]..." << std::endl;
+            std::cerr << "usage: peer [--domain N] [--interface ADDRESS] [--peer ADDRESS]... [--related-sample-identity-pid 0x800f|0x0083|HEX]" << std::endl;
             return 2;
         }
     }
     if (peers.empty()) peers.push_back("127.0.0.1");
     try {
-        Peer peer(domain, interface, peers);
+        Peer peer(domain, interface, peers, g_pid != 0x800f);
         std::string line;
         while (std::getline(std::cin, line)) {
             if (line.empty()) continue;
@@ -716,7 +798,8 @@ int main(int argc, char** argv) {
             try {
                 pj::Value cmd = pj::parse(line);
                 std::string c = cmd["cmd"].str();
-                if (c == "hello") out = pj::Obj().add("ok", "true").add("guid", pj::quote(peer.guid())).add("domain", pj::integer(domain)).str();
+                if (c == "hello") out = pj::Obj().add("ok", "true").add("guid", pj::quote(peer.guid())).add("domain", pj::integer(domain)).add("related_sample_identity_pid", pj::integer(g_pid)).str();
+                else if (c == "pid_stats") out = pj::Obj().add("rewritten", pj::integer(static_cast<int64_t>(g_rewritten.load()))).str();
                 else if (c == "states") out = cmd_states(peer, cmd);
                 else if (c == "description") out = cmd_description(peer, cmd);
                 else if (c == "status") out = cmd_status(peer, cmd);
