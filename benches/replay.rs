@@ -87,6 +87,7 @@ fn main() {
             // States on their own, as the figures in docs/benchmarks.md were taken; motions are
             // measured in benches/motion.rs.
             motion: Some(false),
+            plot: None,
         };
         let started = Instant::now();
         let summary = replay(Params::default(), None, None, &opts).unwrap();

@@ -18,6 +18,7 @@ pub mod collision;
 #[cfg(feature = "testing")]
 pub mod fuzz_entry;
 pub mod limits;
+pub mod markers;
 pub mod math;
 pub mod mesh;
 pub mod model;

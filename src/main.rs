@@ -92,9 +92,14 @@ enum Command {
         /// The robot's frame prefix on /tf (default: the parameters' frame_prefix).
         #[arg(long)]
         frame_prefix: Option<String>,
-        /// Write a rosbag2 bag (metadata.yaml + .mcap) with the `collisions` topic here.
+        /// Write a rosbag2 bag (metadata.yaml + .mcap) here: `/collisions`, the contact and cell
+        /// markers, `/tf` and `/robot_description` (to open beside the input in Foxglove or RViz).
         #[arg(long = "out")]
         out_dir: Option<PathBuf>,
+        /// Draw the collision timeline (one row per link, a bar per interval in collision) into
+        /// this SVG file.
+        #[arg(long)]
+        plot: Option<PathBuf>,
         /// Write one JSON report per state here (the objects of `check --json`).
         #[arg(long)]
         jsonl: Option<PathBuf>,
@@ -157,7 +162,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         #[cfg(feature = "ros")]
         Command::Run { model, ros_args } => cli::run::run(&model, &ros_args),
-        Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, motion, no_motion } => {
+        Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, plot, jsonl, start, end, motion, no_motion } => {
             let motion = if motion {
                 Some(true)
             } else if no_motion {
@@ -165,7 +170,8 @@ fn run(cli: Cli) -> Result<()> {
             } else {
                 None
             };
-            let opts = thickness_collision::replay::ReplayOptions { bag, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, progress: true, motion };
+            let opts =
+                thickness_collision::replay::ReplayOptions { bag, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, progress: true, motion, plot };
             cli::replay::replay(&model, &opts)
         }
     }

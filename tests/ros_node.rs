@@ -111,10 +111,11 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     for key in ["input_rate_hz", "states_received", "states_checked", "states_skipped", "check_seconds_mean", "check_seconds_max"] {
         assert!(diag["values"][key].is_string(), "diagnostics lack {key}: {diag}");
     }
-    // Contact markers: sphere lists of the contact points, at most marker_rate (10 Hz).
+    // Contact markers: a DELETEALL, then a sphere list of the contact points (when there are
+    // any), at most marker_rate (10 Hz).
     let cm = answer["contact_markers"].as_array().unwrap_or_else(|| panic!("no contact markers: {answer}"));
     let seconds = answer["states_seconds"].as_f64().unwrap();
-    assert!(!cm.is_empty() && cm.iter().all(|m| m["type"] == 7), "{cm:?}");
+    assert!(!cm.is_empty() && cm.iter().all(|m| m["deleteall_first"] == true && (m["type"] == 7 || m["type"].is_null())), "{cm:?}");
     assert!(cm.iter().any(|m| m["points"].as_u64().unwrap() > 0), "{cm:?}");
     assert!((cm.len() as f64) <= seconds * 10.0 + 2.0, "{} contact marker messages in {seconds:.2} s exceed 10 Hz", cm.len());
     // Parameter services: get, a refused set, a set that rebuilds the cells, get again.

@@ -10,7 +10,7 @@ mod bounded;
 mod definitions;
 pub mod moveit;
 
-pub use self::definitions::{full_definition, COLLISION_REPORT_TYPE};
+pub use self::definitions::{full_definition, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};
 
 use serde::{Deserialize, Deserializer, Serialize};
 

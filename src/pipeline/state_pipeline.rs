@@ -10,7 +10,7 @@ use super::tf_tree::{TfRejection, TfTree};
 use crate::checker::{Checker, CheckerError, StateError, StateReport};
 use crate::math::Pose;
 use crate::model::Params;
-use crate::msgs::{CollisionReport, JointState, TfMessage, Time};
+use crate::msgs::{CollisionReport, Header, JointState, Quaternion, TfMessage, Time, Transform, TransformStamped, Vector3};
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -231,6 +231,51 @@ impl Pipeline {
             _ => StateReport { motion: true, ..StateReport::failed("a motion between a joint state and link poses cannot be checked") },
         };
         CheckedState { stamp: to.stamp, report }
+    }
+
+    /// The world pose of every link of a joint state (forward kinematics, as the check computed
+    /// them) as a `/tf` message: `world_frame` to each link's frame (`frame_prefix` + name), stamped
+    /// with the state. `None` for a state made of link poses (its `/tf` came with the input).
+    pub fn link_transforms(&self, state: &RobotState) -> Option<TfMessage> {
+        let StatePose::Joints(q) = &state.pose else { return None };
+        let robot = self.checker.robot();
+        // A state this pipeline accepted has a position for every joint: FK cannot fail on it.
+        let poses = robot.forward_kinematics(q, self.checker.base_pose()).ok()?;
+        let (world, prefix) = (&self.params().world_frame, &self.params().frame_prefix);
+        let transforms = robot
+            .links
+            .iter()
+            .zip(&poses)
+            .map(|(link, pose)| (format!("{prefix}{}", link.name), pose))
+            // A root link named like the world frame would be its own parent.
+            .filter(|(frame, _)| frame != world)
+            .map(|(child_frame_id, pose)| {
+                let (t, r) = (pose.translation.vector, pose.rotation.coords);
+                TransformStamped {
+                    header: Header { stamp: state.stamp, frame_id: world.clone() },
+                    child_frame_id,
+                    transform: Transform { translation: Vector3 { x: t.x, y: t.y, z: t.z }, rotation: Quaternion { x: r.x, y: r.y, z: r.z, w: r.w } },
+                }
+            })
+            .collect();
+        Some(TfMessage { transforms })
+    }
+
+    /// The URDF text of the robot in force, for viewers that draw it: the `robot_description`
+    /// received, else the file `--robot` or the parameters name (else the bundled arm's), read now.
+    pub fn robot_urdf(&self) -> Result<String, crate::limits::InputFileError> {
+        match &self.source {
+            RobotSource::Description { urdf, .. } => Ok(urdf.to_string()),
+            RobotSource::Files { robot } => {
+                let param = &self.params().robot_description_file;
+                let path = match robot {
+                    Some(p) => p.clone(),
+                    None if param.is_empty() => crate::model::bundled_config_dir().join("example_workcell/robot.urdf"),
+                    None => PathBuf::from(param),
+                };
+                crate::limits::read_regular_text(&path, "robot URDF", crate::limits::MAX_DESCRIPTION_BYTES)
+            }
+        }
     }
 
     /// The states accepted since the last report, oldest first, as one report stamped with the

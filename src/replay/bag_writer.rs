@@ -1,27 +1,44 @@
 //! Writing a rosbag2 bag: a directory with `metadata.yaml` and one `.mcap` file.
 
 use super::cdr::encode_cdr_le;
-use crate::msgs::{full_definition, CollisionReport, COLLISION_REPORT_TYPE};
+use crate::msgs::full_definition;
 use anyhow::{Context, Result};
+use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-/// Writes `collisions` reports into a new rosbag2 MCAP bag.
+/// The QoS `ros2 bag record` stores for a transient-local ("latched") publisher. `ros2 bag play`
+/// offers a topic with the QoS recorded for it, so RViz (which subscribes to
+/// `/robot_description` transient local) gets the description and the cells whenever it joins.
+const LATCHED_QOS: &str = "- history: 3\n  depth: 0\n  reliability: 1\n  durability: 1\n  deadline:\n    sec: 9223372036\n    nsec: 854775807\n  lifespan:\n    sec: 9223372036\n    nsec: 854775807\n  liveliness: 1\n  liveliness_lease_duration:\n    sec: 9223372036\n    nsec: 854775807\n  avoid_ros_namespace_conventions: false";
+
+/// A topic of a [`BagWriter`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TopicId(usize);
+
+struct TopicEntry {
+    name: String,
+    type_name: &'static str,
+    channel: u16,
+    qos: &'static str,
+    count: u64,
+}
+
+/// Writes messages on a few topics into a new rosbag2 MCAP bag.
 pub struct BagWriter {
     dir: PathBuf,
     file_name: String,
     writer: mcap::Writer<BufWriter<std::fs::File>>,
-    channel: u16,
-    topic: String,
-    count: u64,
+    schemas: BTreeMap<&'static str, u16>,
+    topics: Vec<TopicEntry>,
     first: Option<i64>,
     last: i64,
 }
 
 impl BagWriter {
-    /// Creates `dir` (which must not exist yet, as `ros2 bag record -o` requires) with one topic.
-    pub fn create(dir: &Path, topic: &str) -> Result<BagWriter> {
+    /// Creates `dir`, which must not exist yet (as `ros2 bag record -o` requires).
+    pub fn create(dir: &Path) -> Result<BagWriter> {
         if dir.exists() {
             anyhow::bail!("output bag {} already exists", dir.display());
         }
@@ -30,22 +47,43 @@ impl BagWriter {
         let file_name = format!("{name}_0.mcap");
         let file = std::fs::File::create(dir.join(&file_name)).with_context(|| format!("cannot create {}", dir.join(&file_name).display()))?;
         // Uncompressed, as `ros2 bag record` writes MCAP by default; zstd cost ~15 % of a replay.
-        let mut writer = mcap::WriteOptions::new().profile("ros2").library("thickness_collision").compression(None).create(BufWriter::new(file))?;
-        let definition = full_definition(COLLISION_REPORT_TYPE).unwrap_or_default();
-        let schema = writer.add_schema(COLLISION_REPORT_TYPE, "ros2msg", definition.as_bytes())?;
-        let mut metadata = BTreeMap::new();
-        let _ = metadata.insert("offered_qos_profiles".to_owned(), String::new());
-        let channel = writer.add_channel(schema, topic, "cdr", &metadata)?;
-        Ok(BagWriter { dir: dir.to_owned(), file_name, writer, channel, topic: topic.to_owned(), count: 0, first: None, last: 0 })
+        let writer = mcap::WriteOptions::new().profile("ros2").library("thickness_collision").compression(None).create(BufWriter::new(file))?;
+        Ok(BagWriter { dir: dir.to_owned(), file_name, writer, schemas: BTreeMap::new(), topics: Vec::new(), first: None, last: 0 })
     }
 
-    /// Appends one report received at `log_time` (nanoseconds).
-    pub fn write(&mut self, report: &CollisionReport, log_time: i64) -> Result<()> {
-        let data = encode_cdr_le(report);
+    /// Adds a topic of a type this crate has the full definition of (`crate::msgs::full_definition`);
+    /// `latched` records it as offered transient local.
+    pub fn add_topic(&mut self, topic: &str, type_name: &'static str, latched: bool) -> Result<TopicId> {
+        let schema = match self.schemas.get(type_name) {
+            Some(id) => *id,
+            None => {
+                let definition = full_definition(type_name).with_context(|| format!("no message definition for {type_name}"))?;
+                let id = self.writer.add_schema(type_name, "ros2msg", definition.as_bytes())?;
+                let _ = self.schemas.insert(type_name, id);
+                id
+            }
+        };
+        let qos = if latched { LATCHED_QOS } else { "" };
+        let mut metadata = BTreeMap::new();
+        let _ = metadata.insert("offered_qos_profiles".to_owned(), qos.to_owned());
+        let channel = self.writer.add_channel(schema, topic, "cdr", &metadata)?;
+        self.topics.push(TopicEntry { name: topic.to_owned(), type_name, channel, qos, count: 0 });
+        Ok(TopicId(self.topics.len() - 1))
+    }
+
+    /// Appends one message received at `log_time` (nanoseconds).
+    pub fn write<T: Serialize>(&mut self, topic: TopicId, msg: &T, log_time: i64) -> Result<()> {
+        self.write_raw(topic, &encode_cdr_le(msg), log_time)
+    }
+
+    /// Appends one message already in CDR (with its encapsulation header), as copied from a bag.
+    pub fn write_raw(&mut self, topic: TopicId, data: &[u8], log_time: i64) -> Result<()> {
+        let entry = &mut self.topics[topic.0];
+        // MCAP sequence numbers are 32 bits and may wrap; readers order by log time.
         let header =
-            mcap::records::MessageHeader { channel_id: self.channel, sequence: self.count as u32, log_time: log_time as u64, publish_time: log_time as u64 };
-        self.writer.write_to_known_channel(&header, &data)?;
-        self.count += 1;
+            mcap::records::MessageHeader { channel_id: entry.channel, sequence: entry.count as u32, log_time: log_time as u64, publish_time: log_time as u64 };
+        self.writer.write_to_known_channel(&header, data)?;
+        entry.count += 1;
         let _ = self.first.get_or_insert(log_time);
         self.last = self.last.max(log_time);
         Ok(())
@@ -56,14 +94,21 @@ impl BagWriter {
         let _ = self.writer.finish()?;
         let start = self.first.unwrap_or(0);
         let duration = self.last - start;
+        let total: u64 = self.topics.iter().map(|t| t.count).sum();
+        let mut topics = String::new();
+        for t in &self.topics {
+            // A YAML double-quoted scalar: the QoS text's newlines as \n.
+            let qos = t.qos.replace('\n', "\\n");
+            topics += &format!(
+                "    - topic_metadata:\n        name: {}\n        type: {}\n        serialization_format: cdr\n        offered_qos_profiles: \"{qos}\"\n      message_count: {}\n",
+                t.name, t.type_name, t.count
+            );
+        }
         let meta = format!(
-            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  duration:\n    nanoseconds: {duration}\n  starting_time:\n    nanoseconds_since_epoch: {start}\n  message_count: {n}\n  topics_with_message_count:\n    - topic_metadata:\n        name: {topic}\n        type: {ty}\n        serialization_format: cdr\n        offered_qos_profiles: ''\n      message_count: {n}\n  compression_format: ''\n  compression_mode: ''\n  relative_file_paths:\n    - {file}\n  files:\n    - path: {file}\n      starting_time:\n        nanoseconds_since_epoch: {start}\n      duration:\n        nanoseconds: {duration}\n      message_count: {n}\n",
-            n = self.count,
-            topic = self.topic,
-            ty = COLLISION_REPORT_TYPE,
+            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  duration:\n    nanoseconds: {duration}\n  starting_time:\n    nanoseconds_since_epoch: {start}\n  message_count: {total}\n  topics_with_message_count:\n{topics}  compression_format: ''\n  compression_mode: ''\n  relative_file_paths:\n    - {file}\n  files:\n    - path: {file}\n      starting_time:\n        nanoseconds_since_epoch: {start}\n      duration:\n        nanoseconds: {duration}\n      message_count: {total}\n",
             file = self.file_name,
         );
-        std::fs::write(self.dir.join("metadata.yaml"), meta)?;
+        std::fs::write(self.dir.join("metadata.yaml"), meta).with_context(|| format!("cannot write {}", self.dir.join("metadata.yaml").display()))?;
         Ok(self.dir)
     }
 }

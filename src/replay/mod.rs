@@ -1,13 +1,15 @@
 //! Replay of recorded rosbag2 bags (MCAP or sqlite3) through the same pipeline as the node:
-//! joint states (or `/tf`) in, one collision report per state out, as JSON lines and/or as a new
-//! rosbag2 bag with the `collisions` topic.
+//! joint states (or `/tf`) in, one collision report per state out, as JSON lines, as a new rosbag2
+//! bag with the `collisions` topic, markers and the robot for viewers, and/or as a timeline SVG.
 
 mod bag_reader;
 mod bag_writer;
 mod cdr;
 mod replay_run;
+mod timeline;
+mod timeline_svg;
 
 pub use self::bag_reader::{open_bag, BagError, BagMessage, BagReader};
-pub use self::bag_writer::BagWriter;
+pub use self::bag_writer::{BagWriter, TopicId};
 pub use self::cdr::{decode_cdr, encode_cdr_le, CdrError};
 pub use self::replay_run::{replay, ReplayOptions, ReplaySummary};

@@ -5,7 +5,7 @@
 //! LOCALHOST` or `ROS_LOCALHOST_ONLY=1` bind the participant to 127.0.0.1 (ros2-client ignores
 //! these variables itself, so the participant is built here).
 
-mod markers;
+mod diagnostics;
 mod msg_impls;
 mod node_run;
 mod param_services;

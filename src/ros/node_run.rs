@@ -5,13 +5,14 @@
 //! current joint state: no geometry) and checked on a worker thread of their own, so a long
 //! trajectory never stalls the live stream; the loop sends the answer when the worker is done.
 
-use super::markers::{cell_markers, contact_markers, diagnostics, NodeStats};
+use super::diagnostics::{diagnostics, NodeStats};
 use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
 use super::param_services::{ros_mapping, ParamRequest, ParamRequests, ParamServers};
 use super::param_values::{declarations, to_json, READ_ONLY};
 use super::ros_args::RosArgs;
 use super::validity_worker::{ValidityWorker, MAX_VALIDITY_PENDING};
 use crate::limits::MAX_DESCRIPTION_BYTES;
+use crate::markers::{cell_markers, contact_markers};
 use crate::model::{Params, PoseSource, ServiceMapping};
 use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
@@ -362,6 +363,10 @@ const STATES_KEPT: usize = 100;
 /// instant either: a process holding gigabytes took 0.6 s to be torn down.)
 const STOP_GRACE: Duration = Duration::from_millis(1000);
 
+/// Contact markers fade half a second after the last report: a node whose input stopped shows no
+/// stale contacts.
+const CONTACT_MARKER_LIFETIME: crate::msgs::DurationMsg = crate::msgs::DurationMsg { sec: 0, nanosec: 500_000_000 };
+
 /// The node's state between messages.
 struct NodeState {
     pipeline: Pipeline,
@@ -468,7 +473,7 @@ impl NodeState {
         let period = Duration::try_from_secs_f64(1.0 / rate).unwrap_or(Duration::from_secs(1));
         if self.last_markers.is_none_or(|t| t.elapsed() >= period) {
             self.last_markers = Some(Instant::now());
-            if io.contacts.publish(contact_markers(&checked.report, &world, checked.stamp)).is_err() {
+            if io.contacts.publish(contact_markers(&checked.report, &world, checked.stamp, CONTACT_MARKER_LIFETIME)).is_err() {
                 self.log.warn("markers", || format!("publishing {} failed", io.names.contacts));
             }
         }

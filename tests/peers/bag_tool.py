@@ -1,7 +1,7 @@
 """rosbag2 peer for tests/replay_bags.rs: writes input bags with rosbags, reads output bags back
 with rosbags and with mcap-ros2-support, and parses the project's .msg/.srv files.
 
-stdin: a JSON request with "op": "write" | "read" | "parse".
+stdin: a JSON request with "op": "write" | "read" | "view" | "parse".
 """
 import json
 import sys
@@ -83,6 +83,40 @@ def read(req):
         for m in read_ros2_messages(str(f), topics=["/collisions"]):
             msg = m.ros_msg
             out["mcap_ros2"].append({"log_time": m.log_time_ns, "schema": m.schema.name, "in_collision": bool(msg.in_collision), "contacts": contacts(msg)})
+    return out
+
+
+def view(req):
+    """What a viewer gets from replay's output bag: every topic decoded with mcap-ros2-support
+    (from the schemas in the file alone), and the topics and counts rosbags reads in metadata.yaml."""
+    from mcap_ros2.reader import read_ros2_messages
+    stamp = lambda s: s.sec * 1_000_000_000 + s.nanosec
+    xyz = lambda p: [p.x, p.y, p.z]
+    out = {"schemas": {}, "collisions": [], "contacts": [], "cells": [], "tf": [], "robot_description": []}
+    for f in sorted(Path(req["path"]).glob("*.mcap")):
+        for m in read_ros2_messages(str(f)):
+            msg, topic = m.ros_msg, m.channel.topic
+            out["schemas"][topic] = m.schema.name
+            if topic == "/collisions":
+                out["collisions"].append({"log_time": m.log_time_ns, "stamp": stamp(msg.header.stamp), "frame_id": msg.header.frame_id,
+                                          "positions": [xyz(c.position) for c in msg.contacts], "normals": [xyz(c.normal) for c in msg.contacts],
+                                          "depths": [c.depth for c in msg.contacts], "links": [c.link_name for c in msg.contacts],
+                                          "objects": [c.object_name for c in msg.contacts]})
+            elif topic in ("/collision_markers/contacts", "/collision_markers/cells"):
+                markers = [{"ns": k.ns, "id": k.id, "type": k.type, "action": k.action, "frame_id": k.header.frame_id,
+                            "stamp": stamp(k.header.stamp), "points": [xyz(p) for p in k.points] if topic.endswith("contacts") else len(k.points),
+                            "colors": len(k.colors), "text": k.text} for k in msg.markers]
+                out["contacts" if topic.endswith("contacts") else "cells"].append({"log_time": m.log_time_ns, "markers": markers})
+            elif topic == "/tf":
+                out["tf"].append({"log_time": m.log_time_ns, "transforms": [
+                    {"parent": t.header.frame_id, "child": t.child_frame_id, "stamp": stamp(t.header.stamp),
+                     "translation": xyz(t.transform.translation),
+                     "rotation": [t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z, t.transform.rotation.w]}
+                    for t in msg.transforms]})
+            elif topic == "/robot_description":
+                out["robot_description"].append(msg.data)
+    with Reader(req["path"]) as r:
+        out["rosbags_topics"] = {c.topic: [c.msgtype, c.msgcount, c.ext.offered_qos_profiles != []] for c in r.connections}
     return out
 
 
@@ -170,4 +204,4 @@ def write_many(req):
 
 
 req = json.load(sys.stdin)
-json.dump({"write": write, "read": read, "parse": parse, "write_many": write_many}[req["op"]](req), sys.stdout)
+json.dump({"write": write, "read": read, "view": view, "parse": parse, "write_many": write_many}[req["op"]](req), sys.stdout)

@@ -155,7 +155,12 @@ if contacts_r is not None:
     out["states_seconds"] = time.time() - t_states
     time.sleep(0.3)
     msgs = contacts_r.take(N=1000)
-    out["contact_markers"] = [{"type": m.markers[0].type, "points": len(m.markers[0].points)} for m in msgs if m.markers]
+    # Each array: a DELETEALL, then (when the report has contacts) the sphere list of the points.
+    def contact_array(m):
+        spheres = [k for k in m.markers if k.ns == "contacts"]
+        return {"deleteall_first": bool(m.markers) and m.markers[0].action == 3,
+                "type": spheres[0].type if spheres else None, "points": len(spheres[0].points) if spheres else 0}
+    out["contact_markers"] = [contact_array(m) for m in msgs]
 
 if req.get("service_states"):
     sv = [js(s) for s in req["service_states"]]

@@ -1,68 +1,8 @@
-//! RViz markers of the cells and the contacts, and the `/diagnostics` status.
+//! The node's `/diagnostics` status and the counters behind it.
 
-use crate::checker::{Checker, StateReport};
-use crate::msgs::{ColorRgba, DiagnosticArray, DiagnosticStatus, DurationMsg, Header, KeyValue, Marker, MarkerArray, Point, Quaternion, Time, Vector3};
+use crate::msgs::{DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time};
 use crate::pipeline::SkipCause;
 use std::collections::BTreeMap;
-
-const TRIANGLE_LIST: i32 = 11;
-const SPHERE_LIST: i32 = 7;
-
-fn point(v: crate::math::Vector) -> Point {
-    Point { x: v.x, y: v.y, z: v.z }
-}
-
-/// One triangle-list marker per thin surface with the faces of its cells (world frame), at most
-/// `max_cells` cells in all (the first ones of each object in turn).
-pub fn cell_markers(checker: &Checker, max_cells: usize, frame: &str, stamp: Time) -> MarkerArray {
-    let mut markers = Vec::new();
-    let mut left = max_cells;
-    for (id, object) in checker.scene().objects().iter().enumerate() {
-        let Some(area) = object.area() else { continue };
-        let mut points = Vec::new();
-        for cell in area.cells.iter().take(left) {
-            let v = cell.vertices().map(|p| object.pose * p);
-            let [b0, b1, b2, f0, f1, f2] = v;
-            let mut tri = vec![[b0, b2, b1], [f0, f1, f2]];
-            for (i, j) in [(0, 1), (1, 2), (2, 0)] {
-                tri.push([v[i], v[j], v[3 + j]]);
-                tri.push([v[i], v[3 + j], v[3 + i]]);
-            }
-            points.extend(tri.into_iter().flatten().map(point));
-        }
-        left -= area.cells.len().min(left);
-        markers.push(Marker {
-            header: Header { stamp, frame_id: frame.to_owned() },
-            ns: format!("cells/{}", object.name),
-            id: id as i32,
-            kind: TRIANGLE_LIST,
-            pose: crate::msgs::PoseMsg { position: Point::default(), orientation: Quaternion::default() },
-            scale: Vector3 { x: 1.0, y: 1.0, z: 1.0 },
-            color: ColorRgba { r: 1.0, g: 0.55, b: 0.0, a: 0.35 },
-            points,
-            ..Default::default()
-        });
-    }
-    MarkerArray { markers }
-}
-
-/// A sphere list at the contact points of a report (cleared after half a second).
-pub fn contact_markers(report: &StateReport, frame: &str, stamp: Time) -> MarkerArray {
-    MarkerArray {
-        markers: vec![Marker {
-            header: Header { stamp, frame_id: frame.to_owned() },
-            ns: "contacts".into(),
-            id: 0,
-            kind: SPHERE_LIST,
-            pose: crate::msgs::PoseMsg { position: Point::default(), orientation: Quaternion::default() },
-            scale: Vector3 { x: 0.02, y: 0.02, z: 0.02 },
-            color: ColorRgba { r: 1.0, g: 0.0, b: 0.0, a: 1.0 },
-            lifetime: DurationMsg { sec: 0, nanosec: 500_000_000 },
-            points: report.contacts.iter().filter_map(|c| c.position).map(|p| Point { x: p[0], y: p[1], z: p[2] }).collect(),
-            ..Default::default()
-        }],
-    }
-}
 
 /// Counters the node keeps for `/diagnostics` (skips are counted by the pipeline).
 #[derive(Default)]

@@ -1,0 +1,227 @@
+//! The collision timeline of a replay: per link, the runs of consecutive reports in which it
+//! collides, gathered as the bag streams by (`replay --plot`; drawn by `timeline_svg`).
+
+use crate::checker::StateReport;
+use std::collections::{BTreeSet, HashSet};
+
+/// Bars kept per link before neighbours are merged. A flickering contact at 100 Hz for an hour
+/// makes 180,000 runs; the picture cannot show more than one per few pixels anyway, and memory
+/// must stay bounded by the model, not the bag.
+const MAX_BARS_KEPT: usize = 8192;
+
+/// One link's run of consecutive colliding reports (or several merged).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimelineBar {
+    /// Seconds from the bag's first message to the first colliding report of the run.
+    pub start: f64,
+    /// Seconds from the bag's first message to its last colliding report.
+    pub end: f64,
+    /// Number of the first and the last report in the run (from 1, as in the summary).
+    pub states: (usize, usize),
+    /// Reports in which the link collides.
+    pub colliding: u64,
+    /// Of those, the reports whose own state collides (the others are motion-only hits: the
+    /// link met something between two states, not at the state reported).
+    pub state_hits: u64,
+    /// Deepest contact of the link in the run (metres).
+    pub depth: f64,
+    /// Objects (or links, for self-collision) the link touched.
+    pub objects: BTreeSet<String>,
+    /// Runs merged into this bar (1: none).
+    pub runs: u64,
+}
+
+impl TimelineBar {
+    /// No state in it collides: only the motions into them do.
+    pub fn motion_only(&self) -> bool {
+        self.state_hits == 0
+    }
+
+    /// Takes `next` (later) into this bar.
+    pub fn absorb(&mut self, next: TimelineBar) {
+        self.end = next.end;
+        self.states.1 = next.states.1;
+        self.colliding += next.colliding;
+        self.state_hits += next.state_hits;
+        self.depth = self.depth.max(next.depth);
+        self.objects.extend(next.objects);
+        self.runs += next.runs;
+    }
+}
+
+/// One row of the picture.
+#[derive(Clone, Debug)]
+pub struct TimelineRow {
+    /// The link.
+    pub link: String,
+    /// Its bars, in time order.
+    pub bars: Vec<TimelineBar>,
+    /// Bars closer than this (seconds) were merged to bound memory (0: none were).
+    merged_within: f64,
+}
+
+/// The deepest contact of the replay: (seconds, report number, link, object, depth).
+pub type TimelineDeepest = (f64, usize, String, String, f64);
+
+/// Everything the picture shows, gathered report by report.
+#[derive(Clone, Debug, Default)]
+pub struct Timeline {
+    /// Rows in the order their links first collided.
+    pub rows: Vec<TimelineRow>,
+    /// Reports recorded.
+    pub reports: usize,
+    /// Reports in collision.
+    pub in_collision: usize,
+    /// Reports in collision with no link colliding at the reported state (motion-only).
+    pub motion_only: usize,
+    /// Seconds from the bag's first message to the last report.
+    pub last_seconds: f64,
+    /// The deepest contact.
+    pub deepest: Option<TimelineDeepest>,
+}
+
+impl Timeline {
+    /// Records the next report, made `seconds` after the bag's first message. `state_links`: for
+    /// a report in collision over a motion, the links that collide at the reported state itself
+    /// (`None` when the report is the state's own check).
+    pub fn record(&mut self, seconds: f64, report: &StateReport, state_links: Option<&HashSet<String>>) {
+        self.reports += 1;
+        self.last_seconds = seconds;
+        let n = self.reports;
+        if !report.in_collision {
+            return;
+        }
+        self.in_collision += 1;
+        // A failed check has no contacts: it counts, but draws no bar.
+        let mut any_state_hit = report.contacts.is_empty();
+        for c in &report.contacts {
+            let state_hit = state_links.is_none_or(|s| s.contains(&c.link_name));
+            any_state_hit |= state_hit;
+            if self.deepest.as_ref().is_none_or(|d| c.depth > d.4) {
+                self.deepest = Some((seconds, n, c.link_name.clone(), c.object_name.clone(), c.depth));
+            }
+            let row = match self.rows.iter().position(|r| r.link == c.link_name) {
+                Some(i) => &mut self.rows[i],
+                None => {
+                    self.rows.push(TimelineRow { link: c.link_name.clone(), bars: Vec::new(), merged_within: 0.0 });
+                    let last = self.rows.len() - 1;
+                    &mut self.rows[last]
+                }
+            };
+            let fresh = TimelineBar {
+                start: seconds,
+                end: seconds,
+                states: (n, n),
+                colliding: 1,
+                state_hits: state_hit as u64,
+                depth: c.depth,
+                objects: BTreeSet::from([c.object_name.clone()]),
+                runs: 1,
+            };
+            match row.bars.last_mut() {
+                // A second contact of the same link in the same report.
+                Some(b) if b.states.1 == n => {
+                    b.depth = b.depth.max(c.depth);
+                    let _ = b.objects.insert(c.object_name.clone());
+                }
+                Some(b) if b.states.1 + 1 == n => {
+                    b.end = seconds;
+                    b.states.1 = n;
+                    b.colliding += 1;
+                    b.state_hits += state_hit as u64;
+                    b.depth = b.depth.max(c.depth);
+                    let _ = b.objects.insert(c.object_name.clone());
+                }
+                Some(b) if seconds - b.end < row.merged_within => b.absorb(fresh),
+                _ => row.bars.push(fresh),
+            }
+            if row.bars.len() > MAX_BARS_KEPT {
+                row.coarsen();
+            }
+        }
+        if !any_state_hit {
+            self.motion_only += 1;
+        }
+    }
+}
+
+impl TimelineRow {
+    /// Merges bars closer than a gap that doubles until at most half of [`MAX_BARS_KEPT`] are left.
+    fn coarsen(&mut self) {
+        let span = self.bars.last().map_or(0.0, |b| b.end) - self.bars.first().map_or(0.0, |b| b.start);
+        let mut gap = (span / MAX_BARS_KEPT as f64).max(self.merged_within * 2.0).max(1e-9);
+        loop {
+            self.bars = merge_bars(std::mem::take(&mut self.bars), |a, b| b.start - a.end < gap);
+            if self.bars.len() <= MAX_BARS_KEPT / 2 {
+                break;
+            }
+            gap *= 2.0;
+        }
+        self.merged_within = gap;
+    }
+}
+
+/// Merges each bar into the one before it while `close(before, bar)`.
+pub fn merge_bars(bars: Vec<TimelineBar>, close: impl Fn(&TimelineBar, &TimelineBar) -> bool) -> Vec<TimelineBar> {
+    let mut out: Vec<TimelineBar> = Vec::with_capacity(bars.len());
+    for b in bars {
+        match out.last_mut() {
+            Some(last) if close(last, &b) => last.absorb(b),
+            _ => out.push(b),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::checker::ReportContact;
+
+    fn hit(links: &[(&str, f64)]) -> StateReport {
+        let contacts = links
+            .iter()
+            .map(|(l, d)| ReportContact {
+                link_name: (*l).into(),
+                object_name: "guard".into(),
+                triangle: 0,
+                depth: *d,
+                position: Some([0.0; 3]),
+                normal: [0.0, 0.0, 1.0],
+                object_type: Default::default(),
+            })
+            .collect::<Vec<_>>();
+        StateReport { in_collision: !contacts.is_empty(), contacts, ..Default::default() }
+    }
+
+    #[test]
+    fn runs_of_consecutive_reports_make_one_bar_per_link() {
+        let mut t = Timeline::default();
+        let plan: [&[(&str, f64)]; 6] = [&[], &[("a", 0.01)], &[("a", 0.03), ("b", 0.0)], &[], &[("a", 0.02)], &[("a", 0.01)]];
+        for (k, links) in plan.iter().enumerate() {
+            let report = hit(links);
+            // Report 3 is a motion whose own state has only `a` colliding.
+            let state = HashSet::from(["a".to_owned()]);
+            t.record(k as f64 * 0.01, &report, (k == 2).then_some(&state));
+        }
+        let a: Vec<_> = t.rows[0].bars.iter().map(|b| (b.states, b.colliding, b.depth)).collect();
+        assert_eq!(a, [((2, 3), 2, 0.03), ((5, 6), 2, 0.02)]);
+        assert_eq!(t.rows[1].link, "b");
+        assert!(t.rows[1].bars[0].motion_only(), "b collided only along the motion into report 3");
+        assert_eq!((t.reports, t.in_collision, t.motion_only), (6, 4, 0));
+        assert_eq!(t.deepest.as_ref().map(|d| (d.1, d.4)), Some((3, 0.03)));
+    }
+
+    #[test]
+    fn a_flickering_link_is_merged_to_bounded_bars() {
+        let mut t = Timeline::default();
+        for k in 0..200_000 {
+            let links: &[(&str, f64)] = if k % 2 == 0 { &[("a", 0.01)] } else { &[] };
+            t.record(k as f64 * 0.01, &hit(links), None);
+        }
+        let bars = &t.rows[0].bars;
+        assert!(bars.len() <= MAX_BARS_KEPT, "{} bars kept", bars.len());
+        assert_eq!(bars.iter().map(|b| b.colliding).sum::<u64>(), 100_000, "every colliding report is in some bar");
+        assert_eq!(bars.iter().map(|b| b.runs).sum::<u64>(), 100_000);
+    }
+}
