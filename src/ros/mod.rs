@@ -1,11 +1,14 @@
 //! The ROS 2 node: `joint_states` in, `collisions` out, and the `check_states` service, over
 //! ros2-client (RustDDS). Nothing here does geometry: states go to [`crate::checker::Checker`].
 //!
-//! DDS stays where the environment says: `ROS_DOMAIN_ID`, and `ROS_AUTOMATIC_DISCOVERY_RANGE=
-//! LOCALHOST` or `ROS_LOCALHOST_ONLY=1` bind the participant to 127.0.0.1 (ros2-client ignores
-//! these variables itself, so the participant is built here).
+//! DDS stays where the environment says: `ROS_DOMAIN_ID`, and `ROS_AUTOMATIC_DISCOVERY_RANGE`
+//! (`LOCALHOST` or `ROS_LOCALHOST_ONLY=1` bind the participant to 127.0.0.1; `SUBNET`, the default,
+//! uses every interface and multicast; `OFF` discovers nobody) with `ROS_STATIC_PEERS`
+//! (ros2-client ignores these variables itself, so the participant is built here:
+//! `discovery_range.rs`).
 
 mod diagnostics;
+mod discovery_range;
 mod msg_impls;
 mod node_run;
 mod param_services;

@@ -6,6 +6,7 @@
 //! trajectory never stalls the live stream; the loop sends the answer when the worker is done.
 
 use super::diagnostics::{diagnostics, NodeStats};
+use super::discovery_range::DiscoverySettings;
 use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
 use super::param_services::{ros_mapping, ParamRequest, ParamRequests, ParamServers};
 use super::param_values::{declarations, to_json, READ_ONLY};
@@ -74,22 +75,16 @@ impl RateLimitedLog {
     }
 }
 
-fn env_flag(name: &str, value: &str) -> bool {
-    std::env::var(name).map(|v| v.eq_ignore_ascii_case(value)).unwrap_or(false)
-}
-
-/// The DDS participant: `ROS_DOMAIN_ID`, and loopback only when the environment asks for it.
-fn participant() -> Result<(DomainParticipant, u16, bool)> {
+/// The DDS participant: `ROS_DOMAIN_ID`, and the discovery range and static peers the
+/// environment asks for ([`DiscoverySettings`]).
+fn participant() -> Result<(DomainParticipant, u16, DiscoverySettings)> {
     let domain: u16 = match std::env::var("ROS_DOMAIN_ID") {
         Ok(v) if !v.trim().is_empty() => v.trim().parse().map_err(|_| anyhow!("ROS_DOMAIN_ID='{v}' is not a domain id (0-232)"))?,
         _ => 0,
     };
-    let localhost = env_flag("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST") || env_flag("ROS_LOCALHOST_ONLY", "1");
-    let mut builder = DomainParticipantBuilder::new(domain);
-    if localhost {
-        builder = builder.with_only_networks([std::net::IpAddr::from([127, 0, 0, 1])]);
-    }
-    Ok((builder.build().context("cannot create the DDS participant")?, domain, localhost))
+    let discovery = DiscoverySettings::from_env()?;
+    let builder = discovery.apply(DomainParticipantBuilder::new(domain));
+    Ok((builder.build().context("cannot create the DDS participant")?, domain, discovery))
 }
 
 /// Reliable, transient local ("latched"), keep last `depth`: how `robot_description`,
@@ -695,7 +690,7 @@ impl NodeState {
 pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     let params = params.with_overrides(&opts.ros_args.params)?;
     let pipeline = Pipeline::new(params, opts.robot.as_deref(), opts.environment.as_deref())?;
-    let (dp, domain, localhost) = participant()?;
+    let (dp, domain, discovery) = participant()?;
     let context = Context::from_domain_participant(dp).map_err(|e| anyhow!("ROS context: {e:?}"))?;
     let namespace = opts.ros_args.namespace.clone().unwrap_or_else(|| "/".into());
     let node_name = opts.ros_args.node_name.clone().unwrap_or_else(|| "thickness_collision".into());
@@ -712,7 +707,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     {
         let s = pipeline.checker().summary();
         let p = pipeline.params();
-        println!("thickness_collision: node {} on DDS domain {domain}{}", node.fully_qualified_name(), if localhost { " (loopback only)" } else { "" });
+        println!("thickness_collision: node {} on DDS domain {domain}, discovery range {}", node.fully_qualified_name(), discovery.describe());
         println!("  robot {} ({} links, {} checked)", s.robot_source, s.robot_links, s.checked_links);
         println!(
             "  environment {} ({} thin surfaces, {} cells, {} solids), built in {:.1} ms",

@@ -8,6 +8,8 @@ use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;
 use std::process::{Child, ChildStdout, Command, Stdio};
 
+pub mod netns;
+
 /// A Cyclone DDS configuration that keeps a peer on loopback: `NetworkInterface 127.0.0.1`, no
 /// multicast, the peer 127.0.0.1 (the network rule in the design notes).
 pub const CYCLONE_LOOPBACK: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers><Peer address="127.0.0.1"/></Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>"#;
@@ -21,6 +23,13 @@ pub fn start_node(args: &[&str], domain: u32) -> (Child, BufReader<ChildStdout>,
 /// [`start_node`] through `wrapper`, a command that ends by exec'ing the node (for example
 /// `unshare -n sh -c 'ip link set lo up && exec "$0" "$@"'`), so the process returned is the node.
 pub fn start_node_wrapped(wrapper: &[&str], args: &[&str], domain: u32) -> (Child, BufReader<ChildStdout>, String) {
+    start_node_env(wrapper, args, domain, &[])
+}
+
+/// [`start_node_wrapped`] with `env` applied after the loopback defaults: `(name, Some(value))`
+/// sets a variable, `(name, None)` removes it (the two-host test removes `ROS_LOCALHOST_ONLY` and
+/// sets its own `ROS_AUTOMATIC_DISCOVERY_RANGE`, inside its own network namespaces only).
+pub fn start_node_env(wrapper: &[&str], args: &[&str], domain: u32, env: &[(&str, Option<&str>)]) -> (Child, BufReader<ChildStdout>, String) {
     let bin = env!("CARGO_BIN_EXE_thickness_collision");
     let mut command = match wrapper.split_first() {
         Some((first, rest)) => {
@@ -39,16 +48,15 @@ pub fn start_node_wrapped(wrapper: &[&str], args: &[&str], domain: u32) -> (Chil
             Ok(())
         });
     }
-    let mut node = command
-        .arg("run")
-        .args(args)
-        .env("ROS_DOMAIN_ID", domain.to_string())
-        .env("ROS_LOCALHOST_ONLY", "1")
-        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let _ =
+        command.arg("run").args(args).env("ROS_DOMAIN_ID", domain.to_string()).env("ROS_LOCALHOST_ONLY", "1").env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST");
+    for (name, value) in env {
+        let _ = match value {
+            Some(v) => command.env(name, v),
+            None => command.env_remove(name),
+        };
+    }
+    let mut node = command.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
     let mut out = BufReader::new(node.stdout.take().unwrap());
     let mut banner = String::new();
     while !banner.contains("serves") {

@@ -5,7 +5,7 @@ project's own .msg files, and calls the check_states service (Cyclone's request/
 Loopback only: the caller sets CYCLONEDDS_URI (127.0.0.1, no multicast, peer 127.0.0.1).
 
 stdin: {"domain": id, "states": [{"name": [...], "position": [...], "stamp": ns}], "bad": [...],
-        "service_states": [...], "timeout": s}
+        "service_states": [...], "timeout": s, "warmup": s (15), "service_wait": s (15)}
 stdout: {"reports": [...], "service": [...]}
 """
 import json
@@ -37,13 +37,13 @@ def pv_double(x):
                           bool_array_value=[], integer_array_value=[], double_array_value=[], string_array_value=[])
 
 
-def call(dp, service, req_type, resp_type, request, wait=15, make=None):
+def call(dp, service, req_type, resp_type, request, wait=None, make=None):
     """One service call. Matching is seen on our side before the node has matched us, and a
     request written in between is lost: so the request is sent again (with a fresh one from
     `make(k)` when given) after each second without an answer."""
     w = DataWriter(dp, Topic(dp, f"rq/{service}Request", req_type), qos=reliable)
     r = DataReader(dp, Topic(dp, f"rr/{service}Reply", resp_type), qos=reliable)
-    end = time.time() + wait
+    end = time.time() + (req.get("service_wait", 15) if wait is None else wait)
     while (w.get_matched_subscriptions() == [] or r.get_matched_publications() == []) and time.time() < end:
         time.sleep(0.05)
     k = 0
@@ -129,7 +129,7 @@ if burst:
 # Warm-up: the node may not have matched our writer yet; send until a report comes back.
 if req.get("states") or req.get("bad"):
     warm = {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}
-    end = time.time() + 15
+    end = time.time() + req.get("warmup", 15)
     while time.time() < end and not collect(1, 0.5):
         writer.write(js(warm))
     collect(10 ** 9, 0.3)

@@ -78,6 +78,9 @@ pub struct DomainParticipantBuilder {
 
   same_host_loopback: bool, // prefer loopback for same-host peers + localhost SPDP discovery peers
 
+  // thickness_collision patch: static SPDP peers and isolated discovery (PATCHES.md, change 6).
+  discovery_peers: DiscoveryPeers,
+
   socket_receive_buffer_size: usize,
   socket_send_buffer_size: usize,
 
@@ -93,6 +96,7 @@ impl DomainParticipantBuilder {
       domain_id,
       only_networks: None,
       same_host_loopback: true,
+      discovery_peers: DiscoveryPeers::default(),
       socket_receive_buffer_size: Self::DEFAULT_SOCKET_RECEIVE_BUFFER_SIZE,
       socket_send_buffer_size: Self::DEFAULT_SOCKET_SEND_BUFFER_SIZE,
       #[cfg(feature = "security")]
@@ -126,6 +130,27 @@ impl DomainParticipantBuilder {
   /// `src/rtps/loopback_same_host_design.md`.
   pub fn same_host_loopback(mut self, enabled: bool) -> Self {
     self.same_host_loopback = enabled;
+    self
+  }
+
+  /// thickness_collision patch (PATCHES.md, change 6): hosts to announce this
+  /// participant to by unicast SPDP, besides multicast (ROS 2's
+  /// `ROS_STATIC_PEERS`). Each address gets SPDP at the well-known unicast
+  /// discovery ports of participant ids `0..SPDP_LOCALHOST_PEER_COUNT` of this
+  /// domain, every SPDP period, as the localhost peers do.
+  pub fn with_static_peers(mut self, addrs: impl IntoIterator<Item = impl Into<IpAddr>>) -> Self {
+    self.discovery_peers.static_peers = addrs.into_iter().map(Into::into).collect();
+    self
+  }
+
+  /// thickness_collision patch (PATCHES.md, change 6): no discovery of other
+  /// participants at all (ROS 2's `ROS_AUTOMATIC_DISCOVERY_RANGE=OFF`). The
+  /// participant publishes no SPDP announcement (so no peer learns its
+  /// locators) and ignores the SPDP announcements of every participant but
+  /// itself (so it never matches a remote endpoint); its own readers and
+  /// writers still match each other.
+  pub fn isolated_discovery(mut self, isolated: bool) -> Self {
+    self.discovery_peers.isolated = isolated;
     self
   }
 
@@ -344,6 +369,7 @@ impl DomainParticipantBuilder {
       self.socket_send_buffer_size,
       self.only_networks,
       self.same_host_loopback,
+      self.discovery_peers,
       dp_waker,
       discovery_sample_sender,
     )?;
@@ -393,6 +419,16 @@ impl DomainParticipantBuilder {
       Err(e) => create_error_poisoned!("Discovery thread channel error: {e:?}"),
     }
   }
+}
+
+/// thickness_collision patch (PATCHES.md, change 6): where SPDP goes besides
+/// multicast and the localhost peers, and whether discovery is off.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct DiscoveryPeers {
+  /// Hosts that get unicast SPDP at the well-known discovery ports.
+  pub(crate) static_peers: Vec<IpAddr>,
+  /// No SPDP sent, other participants' SPDP ignored.
+  pub(crate) isolated: bool,
 }
 
 /// DDS DomainParticipant
@@ -649,6 +685,11 @@ impl DomainParticipant {
 
   pub(crate) fn self_locators(&self) -> HashMap<mio1::Token, Vec<Locator>> {
     self.dpi.lock().unwrap().self_locators()
+  }
+
+  // thickness_collision patch (PATCHES.md, change 6)
+  pub(crate) fn discovery_isolated(&self) -> bool {
+    self.dpi.lock().is_ok_and(|g| g.discovery_isolated())
   }
 } // end impl DomainParticipant
 
@@ -977,6 +1018,7 @@ impl DomainParticipantDisc {
     socket_send_buffer_size: usize,
     only_networks: Option<Vec<IpAddr>>,
     same_host_loopback: bool,
+    discovery_peers: DiscoveryPeers,
     dp_waker: LoopWaker,
     discovery_sample_sender: ReadySender<mio1::Token>,
   ) -> CreateResult<Self> {
@@ -994,6 +1036,7 @@ impl DomainParticipantDisc {
       socket_send_buffer_size,
       only_networks,
       same_host_loopback,
+      discovery_peers,
       dp_waker,
       discovery_sample_sender,
     )?;
@@ -1109,6 +1152,11 @@ impl DomainParticipantDisc {
     self.dpi.self_locators.clone()
   }
 
+  // thickness_collision patch (PATCHES.md, change 6)
+  pub(crate) fn discovery_isolated(&self) -> bool {
+    self.dpi.discovery_isolated
+  }
+
   pub(crate) fn status_channel_receiver(
     &self,
   ) -> &StatusChannelReceiver<DomainParticipantStatusEvent> {
@@ -1194,6 +1242,9 @@ pub(crate) struct DomainParticipantInner {
   security_plugins_handle: Option<SecurityPluginsHandle>,
 
   only_networks: Option<Arc<[IpAddr]>>,
+
+  // thickness_collision patch (PATCHES.md, change 6): read by Discovery.
+  discovery_isolated: bool,
 }
 
 impl Drop for DomainParticipantInner {
@@ -1236,6 +1287,7 @@ impl DomainParticipantInner {
     socket_send_buffer_size: usize,
     only_networks: Option<Vec<IpAddr>>,
     same_host_loopback: bool,
+    discovery_peers: DiscoveryPeers,
     dp_waker: LoopWaker,
     discovery_sample_sender: ReadySender<mio1::Token>,
   ) -> CreateResult<Self> {
@@ -1378,6 +1430,7 @@ impl DomainParticipantInner {
     let disc_db_clone = discovery_db.clone();
     let security_plugins_clone = security_plugins_handle.clone();
     let only_networks_for_ev_loop = only_networks.clone();
+    let discovery_isolated = discovery_peers.isolated;
     let ev_loop_handle = thread::Builder::new()
       .name(format!("RustDDS Participant {participant_id} event loop"))
       .spawn(move || {
@@ -1412,6 +1465,7 @@ impl DomainParticipantInner {
           only_networks_for_ev_loop,
           socket_send_buffer_size,
           same_host_loopback,
+          discovery_peers,
           reader_ready_rx,
           writer_ready_rx,
           dp_waker,
@@ -1464,6 +1518,7 @@ impl DomainParticipantInner {
       self_locators,
       security_plugins_handle,
       only_networks,
+      discovery_isolated,
     })
   }
 

@@ -1005,6 +1005,19 @@ impl Discovery {
             match ds.value {
               Sample::Value(participant_data) => {
                 debug!("spdp_receive discovered {:?}", participant_data);
+                // thickness_collision patch (PATCHES.md, change 6): an isolated
+                // participant ignores every participant but itself.
+                let isolated = self
+                  .domain_participant
+                  .clone()
+                  .upgrade()
+                  .is_some_and(|dp| dp.discovery_isolated());
+                if isolated
+                  && participant_data.participant_guid.prefix != self.domain_participant.guid().prefix
+                {
+                  debug!("spdp_receive: isolated, ignoring {:?}", participant_data.participant_guid);
+                  continue;
+                }
                 self.process_discovered_participant_data(&participant_data);
               }
               // Sample::Dispose means that DomainParticipant was disposed
@@ -1443,6 +1456,11 @@ impl Discovery {
   }
 
   fn spdp_publish(&self, local_dp: &DomainParticipant) {
+    // thickness_collision patch (PATCHES.md, change 6): an isolated participant
+    // announces itself to nobody.
+    if local_dp.discovery_isolated() {
+      return;
+    }
     // setting 5 times the duration so lease doesn't break if update fails once or
     // twice
     let data = SpdpDiscoveredParticipantData::from_local_participant(

@@ -177,6 +177,28 @@ pub fn localhost_spdp_peer_locators(
     .collect()
 }
 
+/// thickness_collision patch (PATCHES.md, change 6): the unicast SPDP
+/// destinations of static peers (ROS 2's `ROS_STATIC_PEERS`):
+/// `peer:spdp_well_known_unicast_port(domain_id, pid)` for every peer and every
+/// `pid` in `0..max_participants`.
+pub fn static_spdp_peer_locators(
+  peers: &[IpAddr],
+  domain_id: u16,
+  max_participants: u16,
+) -> Vec<Locator> {
+  peers
+    .iter()
+    .flat_map(|peer| {
+      (0..max_participants).map(move |pid| {
+        Locator::from(SocketAddr::new(
+          *peer,
+          crate::network::constant::spdp_well_known_unicast_port(domain_id, pid),
+        ))
+      })
+    })
+    .collect()
+}
+
 pub fn get_local_unicast_locators_filtered(
   port: u16,
   only_networks: Option<&[IpAddr]>,

@@ -13,6 +13,7 @@ use mio1::{Events, Interest, Poll, Token};
 
 use crate::{
   dds::{
+    participant::DiscoveryPeers,
     qos::policy,
     result::{CreateError, CreateResult},
     statusevents::{DomainParticipantStatusEvent, StatusChannelSender},
@@ -27,7 +28,9 @@ use crate::{
     constant::SPDP_LOCALHOST_PEER_COUNT,
     udp_listener::UDPListener,
     udp_sender::UDPSender,
-    util::{local_interface_table, localhost_spdp_peer_locators, IfAddr},
+    util::{
+      local_interface_table, localhost_spdp_peer_locators, static_spdp_peer_locators, IfAddr,
+    },
   },
   polling::{
     new_shared_timer, timeout_until, wake_channel, LoopWaker, ReadyReceiver, SharedTimer,
@@ -140,6 +143,10 @@ pub struct DPEventLoop {
   // route same-host peers over loopback. See
   // `src/rtps/loopback_same_host_design.md`.
   same_host_loopback: bool,
+
+  // thickness_collision patch (PATCHES.md, change 6): static SPDP peers, and
+  // no SPDP destinations at all when discovery is isolated.
+  discovery_peers: DiscoveryPeers,
 }
 
 impl DPEventLoop {
@@ -164,6 +171,7 @@ impl DPEventLoop {
     only_networks: Option<Arc<[IpAddr]>>,
     socket_send_buffer_size: usize,
     same_host_loopback: bool,
+    discovery_peers: DiscoveryPeers,
     reader_ready: ReadyReceiver<EntityId>,
     writer_ready: ReadyReceiver<EntityId>,
     waker: LoopWaker,
@@ -257,6 +265,7 @@ impl DPEventLoop {
       participant_status_sender,
       discovery_command_sender,
       same_host_loopback,
+      discovery_peers,
     })
   }
 
@@ -1113,14 +1122,26 @@ impl DPEventLoop {
     // - every writer may route a confirmed same-host peer over loopback.
     // See `src/rtps/loopback_same_host_design.md`.
     new_writer.set_prefer_loopback_same_host(self.same_host_loopback);
-    if self.same_host_loopback
-      && new_writer.guid().entity_id == EntityId::SPDP_BUILTIN_PARTICIPANT_WRITER
+    if new_writer.guid().entity_id == EntityId::SPDP_BUILTIN_PARTICIPANT_WRITER
+      && !self.discovery_peers.isolated
     {
-      new_writer.set_extra_unicast_destinations(localhost_spdp_peer_locators(
+      let mut extra = Vec::new();
+      if self.same_host_loopback {
+        extra = localhost_spdp_peer_locators(
+          self.domain_info.domain_id,
+          self.domain_info.participant_id,
+          SPDP_LOCALHOST_PEER_COUNT,
+        );
+      }
+      // thickness_collision patch (PATCHES.md, change 6): the static peers get
+      // SPDP at the well-known unicast discovery ports of the first
+      // SPDP_LOCALHOST_PEER_COUNT participant ids.
+      extra.extend(static_spdp_peer_locators(
+        &self.discovery_peers.static_peers,
         self.domain_info.domain_id,
-        self.domain_info.participant_id,
         SPDP_LOCALHOST_PEER_COUNT,
       ));
+      new_writer.set_extra_unicast_destinations(extra);
     }
 
     // The doorbell is a shared ready-queue plus the poll waker, not a
@@ -1344,6 +1365,7 @@ mod tests {
         None,
         0,
         true,
+        DiscoveryPeers::default(),
         reader_ready,
         writer_ready,
         waker,
