@@ -218,7 +218,9 @@ mod tests {
         let r = list(&all, &names(&["padding"]), 0);
         assert_eq!((r.names, r.prefixes), (names(&["padding.links", "padding.values"]), names(&["padding"])));
         assert_eq!(list(&all, &names(&["x"]), 1).names, Vec::<String>::new());
-        assert_eq!(list(&all, &names(&["x"]), 2).names, names(&["x.y.z"]));
+        // rclcpp counts the separators after the prefix, the leading one included (".y.z": 2).
+        assert_eq!(list(&all, &names(&["x"]), 2).names, Vec::<String>::new());
+        assert_eq!(list(&all, &names(&["x"]), 3).names, names(&["x.y.z"]));
         assert_eq!(list(&all, &names(&["a"]), 0).names, names(&["a"]));
     }
 
