@@ -9,6 +9,8 @@
 // --interface (127.0.0.1 unless told otherwise), initial peers --peer (127.0.0.1 unless told), no
 // data sharing. Domain: --domain, else ROS_DOMAIN_ID. The PID of the related sample identity:
 // --related-sample-identity-pid, else TC_FASTDDS_RELATED_SAMPLE_IDENTITY_PID, else 0x800f (see below).
+// The UDP socket receive buffer: --receive-buffer, else TC_FASTDDS_RECEIVE_BUFFER, else Fast DDS's
+// default (0: the OS default, net.core.rmem_default), as rmw_fastrtps_cpp leaves it.
 //
 // The client does what rmw_fastrtps_cpp's client does (rmw_fastrtps_shared_cpp, rmw_request.cpp and
 // custom_client_info.hpp): it writes each request with WriteParams whose
@@ -291,12 +293,13 @@ eprosima::fastdds::rtps::TransportInterface* PidRewriteDescriptor::create_transp
 
 class Peer {
 public:
-    Peer(int domain, const std::string& interface, const std::vector<std::string>& peers, bool rewrite) : domain_(domain) {
+    Peer(int domain, const std::string& interface, const std::vector<std::string>& peers, bool rewrite, uint32_t receive_buffer) : domain_(domain) {
         DomainParticipantQos pq = PARTICIPANT_QOS_DEFAULT;
         pq.name("tc_fastdds_peer");
         pq.transport().use_builtin_transports = false;
         auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
         udp->interfaceWhiteList.push_back(interface);
+        if (receive_buffer > 0) udp->receiveBufferSize = receive_buffer;
         if (rewrite) pq.transport().user_transports.push_back(std::make_shared<PidRewriteDescriptor>(udp));
         else pq.transport().user_transports.push_back(udp);
         // Initial peers: the well-known metatraffic unicast ports of participants 0..19 on each
@@ -777,20 +780,23 @@ int main(int argc, char** argv) {
     if (const char* pid = std::getenv("TC_FASTDDS_RELATED_SAMPLE_IDENTITY_PID")) g_pid = static_cast<uint16_t>(std::stoul(pid, nullptr, 16));
     std::string interface = "127.0.0.1";
     std::vector<std::string> peers;
+    uint32_t receive_buffer = 0;  // 0: Fast DDS's default, the OS default socket buffer (as rmw_fastrtps_cpp)
+    if (const char* b = std::getenv("TC_FASTDDS_RECEIVE_BUFFER")) receive_buffer = static_cast<uint32_t>(std::stoul(b));
     for (int i = 1; i + 1 < argc; i += 2) {
         std::string a = argv[i];
         if (a == "--domain") domain = std::atoi(argv[i + 1]);
         else if (a == "--interface") interface = argv[i + 1];
         else if (a == "--peer") peers.push_back(argv[i + 1]);
+        else if (a == "--receive-buffer") receive_buffer = static_cast<uint32_t>(std::stoul(argv[i + 1]));
         else if (a == "--related-sample-identity-pid") g_pid = static_cast<uint16_t>(std::stoul(argv[i + 1], nullptr, 16));
         else {
-            std::cerr << "usage: peer [--domain N] [--interface ADDRESS] [--peer ADDRESS]... [--related-sample-identity-pid 0x800f|0x0083|HEX]" << std::endl;
+            std::cerr << "usage: peer [--domain N] [--interface ADDRESS] [--peer ADDRESS]... [--related-sample-identity-pid 0x800f|0x0083|HEX] [--receive-buffer BYTES]" << std::endl;
             return 2;
         }
     }
     if (peers.empty()) peers.push_back("127.0.0.1");
     try {
-        Peer peer(domain, interface, peers, g_pid != 0x800f);
+        Peer peer(domain, interface, peers, g_pid != 0x800f, receive_buffer);
         std::string line;
         while (std::getline(std::cin, line)) {
             if (line.empty()) continue;
