@@ -313,8 +313,22 @@ fn fastdds_latched_robot_description_is_taken_by_a_node_started_after_it() {
     let mut peer = FastDdsPeer::start(&PeerOptions::loopback(domain));
     assert_eq!(peer.send(&json!({"cmd": "description", "text": urdf}))["ok"], true);
     let (node, out, _banner) = start_node(&["--ros-args", "-p", "check_motion:=false"], domain);
-    // The reports below are the fat arm's only if the node built it from the topic; the warm-up
-    // waits for the node's readers, and a state is answered only after the description's turn.
+    // The node's lines as they come, to wait for it to take the robot before sending states (a
+    // state checked before the description's turn would be the bundled arm's).
+    let (lines_tx, lines) = std::sync::mpsc::channel::<String>();
+    let reader = std::thread::spawn(move || {
+        for line in std::io::BufRead::lines(out).map_while(Result::ok) {
+            let _ = lines_tx.send(line);
+        }
+    });
+    let mut seen = String::new();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while !seen.contains("robot from robot_description") {
+        match lines.recv_timeout(deadline.saturating_duration_since(std::time::Instant::now())) {
+            Ok(line) => seen += &(line + "\n"),
+            Err(_) => panic!("the node did not take the latched robot_description within 30 s; its output: {seen}"),
+        }
+    }
     let a = peer.send(&json!({"cmd": "states", "states": states, "warm": {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}, "timeout": 30}));
     assert_eq!(a["matched"], true, "{a}");
     let readers = peer.send(&json!({"cmd": "status"}))["description_readers"].as_u64().unwrap();
@@ -325,8 +339,13 @@ fn fastdds_latched_robot_description_is_taken_by_a_node_started_after_it() {
         assert_same_report(got, want, &format!("state {k}: the node must check the fat arm from the latched topic"));
     }
     peer.quit();
-    let (rest, err) = stop(node, out);
-    assert!(rest.contains("robot from robot_description"), "stdout: {rest}\nstderr: {err}");
+    let mut node = node;
+    let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
+    let status = node.wait().unwrap();
+    reader.join().unwrap();
+    let rest: Vec<String> = lines.try_iter().collect();
+    assert!(status.success(), "node exit {status:?}");
+    assert!(rest.iter().any(|l| l.contains("shutting down")), "{rest:?}");
 }
 
 /// The parameter services follow `service_mapping`: with `cyclone` they are reached as `ros2 param`
