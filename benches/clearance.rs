@@ -77,16 +77,7 @@ fn main() {
         }
     }
     for (i, (_, hull, _)) in parts.iter().enumerate() {
-        let poly = hull.as_parry();
-        let pts: Vec<[f64; 3]> = poly.points().iter().map(|p| p.to_array()).collect();
-        let adj = poly.vertices_adj_to_face();
-        let mut tri = Vec::new();
-        for f in poly.faces() {
-            let vs = &adj[f.first_vertex_or_edge as usize..(f.first_vertex_or_edge + f.num_vertices_or_edges) as usize];
-            for k in 1..vs.len() - 1 {
-                tri.push([vs[0], vs[k], vs[k + 1]]);
-            }
-        }
+        let (pts, tri) = hull.vertices_and_triangles();
         write_raw(&dir.join(format!("part{i}_vertices.f64")), &pts);
         write_raw(&dir.join(format!("part{i}_triangles.u32")), &tri);
     }

@@ -15,6 +15,9 @@ import coal
 import fcl
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "peers"))
+from hull_parts import coal_convex, read_part  # noqa: E402
+
 d = Path(sys.argv[1])
 meta = json.loads((d / "meta.json").read_text())
 V = np.fromfile(d / "env_vertices.f64", dtype="<f8").reshape(-1, 3)
@@ -22,8 +25,7 @@ T = np.fromfile(d / "env_triangles.u32", dtype="<u4").reshape(-1, 3).astype(np.i
 poses = np.fromfile(d / "poses.f64", dtype="<f8").reshape(meta["states"], meta["parts"], 12)
 parts = []
 for i in range(meta["parts"]):
-    pv = np.fromfile(d / f"part{i}_vertices.f64", dtype="<f8").reshape(-1, 3)
-    pt = np.fromfile(d / f"part{i}_triangles.u32", dtype="<u4").reshape(-1, 3).astype(np.int64)
+    pv, pt = read_part(d, i)
     parts.append((pv, pt))
 S, P = meta["states"], meta["parts"]
 out = {}
@@ -36,13 +38,7 @@ env.addTriangles(T)
 env.endModel()
 shapes = []
 for pv, pt in parts:
-    tris = coal.StdVec_Triangle()
-    for a, b, c in pt:
-        tris.append(coal.Triangle(int(a), int(b), int(c)))
-    verts = coal.StdVec_Vec3s()
-    for v in pv:
-        verts.append(np.asarray(v, dtype=float))
-    shapes.append(coal.Convex(verts, tris))
+    shapes.append(coal_convex(pv, pt))
 tfs = [[coal.Transform3s(poses[s, p, :9].reshape(3, 3).copy(), poses[s, p, 9:].copy()) for p in range(P)] for s in range(S)]
 I = coal.Transform3s()
 req = coal.CollisionRequest()

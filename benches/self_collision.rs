@@ -60,16 +60,7 @@ fn main() {
     for (ti, t) in targets.iter().enumerate() {
         for (pi, (shape, _)) in t.parts.iter().enumerate() {
             let TargetShape::Polytope(hull) = shape else { panic!("Panda links are meshes") };
-            let poly = hull.as_parry();
-            let pts: Vec<[f64; 3]> = poly.points().iter().map(|p| p.to_array()).collect();
-            let adj = poly.vertices_adj_to_face();
-            let mut tri: Vec<[u32; 3]> = Vec::new();
-            for f in poly.faces() {
-                let vs = &adj[f.first_vertex_or_edge as usize..(f.first_vertex_or_edge + f.num_vertices_or_edges) as usize];
-                for m in 1..vs.len() - 1 {
-                    tri.push([vs[0], vs[m], vs[m + 1]]);
-                }
-            }
+            let (pts, tri) = hull.vertices_and_triangles();
             write_raw(&dir.join(format!("part{}_vertices.f64", parts.len())), &pts);
             write_raw(&dir.join(format!("part{}_triangles.u32", parts.len())), &tri);
             parts.push((ti, pi));

@@ -13,6 +13,9 @@ from pathlib import Path
 import coal
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "peers"))
+from hull_parts import coal_convex, read_part  # noqa: E402
+
 d = Path(sys.argv[1])
 meta = json.loads((d / "meta.json").read_text())
 S, P = meta["states"], meta["parts"]
@@ -20,15 +23,8 @@ poses = np.fromfile(d / "poses.f64", dtype="<f8").reshape(S, P, 12)
 pairs = [(int(a), int(b)) for a, b in np.fromfile(d / "pairs.u32", dtype="<u4").reshape(-1, 2)]
 shapes = []
 for i in range(P):
-    pv = np.fromfile(d / f"part{i}_vertices.f64", dtype="<f8").reshape(-1, 3)
-    pt = np.fromfile(d / f"part{i}_triangles.u32", dtype="<u4").reshape(-1, 3).astype(np.int64)
-    tris = coal.StdVec_Triangle()
-    for a, b, c in pt:
-        tris.append(coal.Triangle(int(a), int(b), int(c)))
-    verts = coal.StdVec_Vec3s()
-    for v in pv:
-        verts.append(np.asarray(v, dtype=float))
-    shapes.append(coal.Convex(verts, tris))
+    pv, pt = read_part(d, i)
+    shapes.append(coal_convex(pv, pt))
 tfs = [[coal.Transform3s(poses[s, p, :9].reshape(3, 3).copy(), poses[s, p, 9:].copy()) for p in range(P)] for s in range(S)]
 req = coal.CollisionRequest()
 res = coal.CollisionResult()

@@ -78,16 +78,7 @@ fn compare(name: &str, urdf: &str, srdf: &str, n: usize, seed: u64) -> Outcome {
             }
         };
         kinds.push(serde_json::json!("hull"));
-        let poly = hull.as_parry();
-        let pts: Vec<[f64; 3]> = poly.points().iter().map(|p| p.to_array()).collect();
-        let adj = poly.vertices_adj_to_face();
-        let mut tri: Vec<[u32; 3]> = Vec::new();
-        for f in poly.faces() {
-            let vs = &adj[f.first_vertex_or_edge as usize..(f.first_vertex_or_edge + f.num_vertices_or_edges) as usize];
-            for m in 1..vs.len() - 1 {
-                tri.push([vs[0], vs[m], vs[m + 1]]);
-            }
-        }
+        let (pts, tri) = hull.vertices_and_triangles();
         write_raw(&dir.join(format!("part{k}_vertices.f64")), &pts);
         write_raw(&dir.join(format!("part{k}_triangles.u32")), &tri);
     }

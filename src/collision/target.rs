@@ -244,6 +244,23 @@ impl ConvexHull {
         self.faces.len()
     }
 
+    /// The hull as a triangle mesh (each face fanned from its first vertex), for handing the same
+    /// shape to another checker.
+    pub fn vertices_and_triangles(&self) -> (Vec<[Real; 3]>, Vec<[u32; 3]>) {
+        let poly = &self.parry;
+        let points = poly.points().iter().map(|p| p.to_array()).collect();
+        let adj = poly.vertices_adj_to_face();
+        let mut triangles = Vec::new();
+        for f in poly.faces() {
+            let first = f.first_vertex_or_edge as usize;
+            let vs = &adj[first..first + f.num_vertices_or_edges as usize];
+            for k in 1..vs.len().saturating_sub(1) {
+                triangles.push([vs[0], vs[k], vs[k + 1]]);
+            }
+        }
+        (points, triangles)
+    }
+
     /// The same hull as a parry shape (for GJK-based queries and as a test oracle).
     pub fn as_parry(&self) -> &ConvexPolyhedron {
         &self.parry

@@ -16,6 +16,9 @@ from pathlib import Path
 import coal
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from hull_parts import coal_convex, read_part  # noqa: E402
+
 BAND = 1e-6
 
 d = Path(sys.argv[1])
@@ -44,15 +47,8 @@ for i in range(P):
         centres.append(np.zeros(3))
         radii.append(float(np.hypot(hh, r)))
         continue
-    pv = np.fromfile(d / f"part{i}_vertices.f64", dtype="<f8").reshape(-1, 3)
-    pt = np.fromfile(d / f"part{i}_triangles.u32", dtype="<u4").reshape(-1, 3).astype(np.int64)
-    tris = coal.StdVec_Triangle()
-    for a, b, c in pt:
-        tris.append(coal.Triangle(int(a), int(b), int(c)))
-    verts = coal.StdVec_Vec3s()
-    for v in pv:
-        verts.append(np.asarray(v, dtype=float))
-    shapes.append(coal.Convex(verts, tris))
+    pv, pt = read_part(d, i)
+    shapes.append(coal_convex(pv, pt))
     c = pv.mean(axis=0)
     centres.append(c)
     radii.append(float(np.max(np.linalg.norm(pv - c, axis=1))))
