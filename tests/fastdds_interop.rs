@@ -224,6 +224,24 @@ fn fastdds_topics_services_parameters_and_latched_markers() {
     let d = described[0]["response"]["descriptors"].as_array().unwrap_or_else(|| panic!("describe_parameters: {}", described[0]));
     let types: Vec<(&Value, &Value)> = d.iter().map(|x| (&x["name"], &x["type"])).collect();
     assert_eq!(types, vec![(&json!("default_thickness"), &json!(3)), (&json!("world_frame"), &json!(4)), (&json!("check_motion"), &json!(1))]);
+    let kinds = peer.call(
+        "tc_fast/get_parameter_types",
+        "get_parameter_types",
+        vec![json!({"names": ["default_thickness", "world_frame", "check_motion", "nope"]})],
+        20.0,
+    );
+    assert_eq!(kinds[0]["response"]["types"], json!([3, 4, 1, 0]), "{}", kinds[0]);
+    // set_parameters_atomically: all or nothing (an undeclared name refuses the lot).
+    let atomic = |peer: &mut FastDdsPeer, params: Value| -> Value {
+        let a = peer.call("tc_fast/set_parameters_atomically", "set_parameters_atomically", vec![json!({"parameters": params})], 20.0);
+        a[0]["response"].clone()
+    };
+    let both = atomic(&mut peer, json!([{"name": "default_thickness", "value": double(0.04)}, {"name": "marker_rate", "value": double(5.0)}]));
+    assert_eq!(both["successful"], true, "{both}");
+    let refused = atomic(&mut peer, json!([{"name": "default_thickness", "value": double(0.05)}, {"name": "nope", "value": double(1.0)}]));
+    assert_eq!(refused["successful"], false, "{refused}");
+    let after = get(&mut peer, &["default_thickness", "marker_rate"]);
+    assert_eq!((after[0]["double"].as_f64(), after[1]["double"].as_f64()), (Some(0.04), Some(5.0)), "the refused set changed nothing: {after:?}");
     eprintln!("parameter services answered ({:.1} s)", t0.elapsed().as_secs_f64());
 
     // The latched cells, read by a reader created now (a late joiner, as RViz is), and the status.
@@ -368,6 +386,11 @@ fn parameter_services_follow_service_mapping_cyclone() {
         {"service": "get_parameters", "request": {"names": ["default_thickness"]}},
         {"service": "list_parameters", "request": {"prefixes": ["padding"], "depth": 0}},
         {"service": "describe_parameters", "request": {"names": ["default_thickness", "service_mapping", "no_such_parameter"]}},
+        {"service": "get_parameter_types", "request": {"names": ["default_thickness", "world_frame", "no_such_parameter"]}},
+        {"service": "set_parameters_atomically", "request": {"parameters": [{"name": "default_thickness", "double": 0.04}, {"name": "marker_rate", "double": 5.0}]}},
+        {"service": "set_parameters_atomically", "request": {"parameters": [{"name": "default_thickness", "double": 0.06}, {"name": "no_such_parameter", "double": 1.0}]}},
+        {"service": "set_parameters_atomically", "request": {"parameters": [{"name": "default_thickness", "double": 0.06}, {"name": "world_frame", "double": 1.0}]}},
+        {"service": "get_parameters", "request": {"names": ["default_thickness", "marker_rate"]}},
     ]);
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/param_peer.py");
     let mut child = Command::new(common::python())
@@ -390,6 +413,11 @@ fn parameter_services_follow_service_mapping_cyclone() {
     assert_eq!(answers[3]["values"][0][1], json!(0.05), "{a}");
     assert_eq!(answers[4], json!({"names": ["padding.links", "padding.values"], "prefixes": ["padding"]}), "{a}");
     assert_eq!(answers[5], json!({"types": [3, 4, 0], "read_only": [false, true, true]}), "{a}");
+    assert_eq!(answers[6], json!({"types": [3, 4, 0]}), "{a}");
+    assert_eq!(answers[7]["result"], json!([true, ""]), "{a}");
+    assert_eq!(answers[8]["result"][0], false, "an undeclared name refuses the lot: {a}");
+    assert_eq!(answers[9]["result"][0], false, "a wrong type refuses the lot: {a}");
+    assert_eq!(answers[10]["values"], json!([[3, 0.04, ""], [3, 5.0, ""]]), "the refused sets changed nothing: {a}");
     let (rest, _err) = stop(node, out);
     assert!(rest.contains("parameters changed"), "the accepted set reached the node's loop: {rest}");
 }

@@ -89,6 +89,10 @@ ParameterDescriptor = struct_typed("rcl_interfaces/msg/ParameterDescriptor", [
     ("floating_point_range", t.sequence[FloatingPointRange, 1]), ("integer_range", t.sequence[IntegerRange, 1])])
 DescribeReq = struct_typed("rcl_interfaces/srv/DescribeParameters_Request", [("names", t.sequence[str])])
 DescribeResp = struct_typed("rcl_interfaces/srv/DescribeParameters_Response", [("descriptors", t.sequence[ParameterDescriptor])])
+GetTypesReq = struct_typed("rcl_interfaces/srv/GetParameterTypes_Request", [("names", t.sequence[str])])
+GetTypesResp = struct_typed("rcl_interfaces/srv/GetParameterTypes_Response", [("types", t.sequence[t.uint8])])
+SetAtomicReq = struct_typed("rcl_interfaces/srv/SetParametersAtomically_Request", [("parameters", t.sequence[Parameter])])
+SetAtomicResp = struct_typed("rcl_interfaces/srv/SetParametersAtomically_Response", [("result", SetParametersResult)])
 
 # visualization_msgs and diagnostic_msgs, to read the node's markers and status.
 ColorRGBA = struct_typed("std_msgs/msg/ColorRGBA", [("r", t.float32), ("g", t.float32), ("b", t.float32), ("a", t.float32)])

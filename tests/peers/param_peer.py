@@ -3,12 +3,14 @@ DDS from Python, Cyclone's request/reply mapping (a (guid, seq) header before th
 the reply matched by both), for tests/fastdds_interop.rs (the node with service_mapping:=cyclone).
 Loopback only: the caller sets CYCLONEDDS_URI (127.0.0.1, no multicast, peer 127.0.0.1).
 
-stdin: {"domain": id, "node": "name", "calls": [{"service": "get_parameters"|"set_parameters"|
-        "list_parameters"|"describe_parameters", "request": {...}}], "timeout": s}
-        get/describe: {"names": [...]}; set: {"name": n, "double": x} or {"name": n, "string": s};
-        list: {"prefixes": [...], "depth": n}
-stdout: {"answers": [A or null ...]}; A: get {"values": [[type, double, string]...]},
-        set {"results": [[successful, reason]]}, list {"names", "prefixes"}, describe {"types", "read_only"}
+stdin: {"domain": id, "node": "name", "calls": [{"service": "get_parameters"|"get_parameter_types"|
+        "set_parameters"|"set_parameters_atomically"|"list_parameters"|"describe_parameters",
+        "request": {...}}], "timeout": s}
+        get/get types/describe: {"names": [...]}; set: P = {"name": n, "double": x} or {"name": n,
+        "string": s}; set atomically: {"parameters": [P...]}; list: {"prefixes": [...], "depth": n}
+stdout: {"answers": [A or null ...]}; A: get {"values": [[type, double, string]...]}, get types
+        {"types"}, set {"results": [[successful, reason]]}, set atomically {"result": [successful,
+        reason]}, list {"names", "prefixes"}, describe {"types", "read_only"}
 """
 import json
 import sys
@@ -35,7 +37,8 @@ def with_header(cls):
 
 
 SERVICES = {"get_parameters": (d.GetReq, d.GetResp), "set_parameters": (d.SetReq, d.SetResp),
-            "list_parameters": (d.ListReq, d.ListResp), "describe_parameters": (d.DescribeReq, d.DescribeResp)}
+            "list_parameters": (d.ListReq, d.ListResp), "describe_parameters": (d.DescribeReq, d.DescribeResp),
+            "get_parameter_types": (d.GetTypesReq, d.GetTypesResp), "set_parameters_atomically": (d.SetAtomicReq, d.SetAtomicResp)}
 
 
 def pv(c):
@@ -46,10 +49,12 @@ def pv(c):
 
 
 def body(service, r):
-    if service in ("get_parameters", "describe_parameters"):
+    if service in ("get_parameters", "describe_parameters", "get_parameter_types"):
         return {"names": r["names"]}
     if service == "set_parameters":
         return {"parameters": [d.Parameter(name=r["name"], value=pv(r))]}
+    if service == "set_parameters_atomically":
+        return {"parameters": [d.Parameter(name=x["name"], value=pv(x)) for x in r["parameters"]]}
     return {"prefixes": r.get("prefixes", []), "depth": int(r.get("depth", 0))}
 
 
@@ -60,6 +65,10 @@ def show(service, x):
         return {"results": [[bool(v.successful), v.reason] for v in x.results]}
     if service == "list_parameters":
         return {"names": list(x.result.names), "prefixes": list(x.result.prefixes)}
+    if service == "get_parameter_types":
+        return {"types": [int(v) for v in x.types]}
+    if service == "set_parameters_atomically":
+        return {"result": [bool(x.result.successful), x.result.reason]}
     return {"types": [int(v.type) for v in x.descriptors], "read_only": [bool(v.read_only) for v in x.descriptors]}
 
 

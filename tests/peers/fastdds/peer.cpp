@@ -732,6 +732,41 @@ std::string cmd_call(Peer& peer, const pj::Value& cmd) {
                     .str();
             });
     }
+    if (type == "get_parameter_types") {
+        using Req = rcl_interfaces::srv::GetParameterTypes_Request;
+        using Resp = rcl_interfaces::srv::GetParameterTypes_Response;
+        return call<rcl_interfaces::srv::GetParameterTypes_RequestPubSubType, rcl_interfaces::srv::GetParameterTypes_ResponsePubSubType, Req, Resp>(
+            peer, cmd,
+            [](const pj::Value& q) {
+                Req r;
+                r.names(q["names"].strs());
+                return r;
+            },
+            [](const Resp& r) {
+                std::vector<int64_t> types(r.types().begin(), r.types().end());
+                return pj::Obj().add("types", pj::array(types, [](int64_t x) { return pj::integer(x); })).str();
+            });
+    }
+    if (type == "set_parameters_atomically") {
+        using Req = rcl_interfaces::srv::SetParametersAtomically_Request;
+        using Resp = rcl_interfaces::srv::SetParametersAtomically_Response;
+        return call<rcl_interfaces::srv::SetParametersAtomically_RequestPubSubType, rcl_interfaces::srv::SetParametersAtomically_ResponsePubSubType, Req,
+                    Resp>(
+            peer, cmd,
+            [](const pj::Value& q) {
+                Req r;
+                for (const auto& p : q["parameters"].arr()) {
+                    rcl_interfaces::msg::Parameter par;
+                    par.name(p["name"].str());
+                    par.value(parameter_value(p["value"]));
+                    r.parameters().push_back(par);
+                }
+                return r;
+            },
+            [](const Resp& r) {
+                return pj::Obj().add("successful", pj::boolean(r.result().successful())).add("reason", pj::quote(r.result().reason())).str();
+            });
+    }
     if (type == "list_parameters") {
         using Req = rcl_interfaces::srv::ListParameters_Request;
         using Resp = rcl_interfaces::srv::ListParameters_Response;
