@@ -9,8 +9,9 @@
 //! - `static_peers_without_multicast_cyclone_and_fastdds`: multicast off on both veth ends and no multicast
 //!   route; the node names host B in `ROS_STATIC_PEERS`, the Cyclone peer names no one: the same
 //!   exchange, found only by the node's unicast announcement.
-//! - `range_off_keeps_the_node_alone`: range OFF; the Cyclone peer in B, with multicast on and
-//!   host A named as its peer, gets no match, no report and no service answer while the node runs.
+//! - `range_off_keeps_the_node_alone`: range OFF; the Cyclone and Fast DDS peers in B, with
+//!   multicast on and host A named as their peer, get no match, no report and no service answer
+//!   while the node runs.
 //!
 //! Namespaces need root (CI runs as root): without it these tests fail with the reason.
 
@@ -279,14 +280,28 @@ fn range_off_keeps_the_node_alone() {
     let domain = 172;
     let (mut node, out, banner) = start_node_in_a(&hosts, domain, &[("ROS_AUTOMATIC_DISCOVERY_RANGE", Some("OFF")), ("ROS_STATIC_PEERS", Some(HOST_B))]);
     assert!(banner.contains("discovery range OFF"), "{banner}");
-    // The peer does all it can: multicast on the link and host A named as a unicast peer.
-    let states: Vec<Value> = (0..3).map(state).map(|(n, p)| json!({"name": n, "position": p, "stamp": 5})).collect();
-    let request = json!({"domain": domain, "states": states, "service_states": states, "timeout": 8, "warmup": 4, "service_wait": 6});
-    let answer = run_peer_in_b(&hosts, &cyclone_config(true, &[HOST_A]), &request);
-    assert!(node.try_wait().unwrap().is_none(), "the node must run while the peer tries");
+    // The peers do all they can: multicast on the link and host A named as a unicast peer. Both
+    // run at once (a bounded wait each, about 20 s).
+    let states: Vec<Value> = (0..2).map(state).map(|(n, p)| json!({"name": n, "position": p, "stamp": 5})).collect();
+    let request = json!({"domain": domain, "states": states, "service_states": states, "timeout": 8, "warmup": 4, "service_wait": 5});
+    let t = Instant::now();
+    let (answer, fast, call) = std::thread::scope(|scope| {
+        let cyclone = scope.spawn(|| run_peer_in_b(&hosts, &cyclone_config(true, &[HOST_A]), &request));
+        let opts = PeerOptions { wrapper: hosts.in_b(), domain, interface: HOST_B.into(), peers: vec![HOST_A.into()], env: vec![] };
+        let mut peer = FastDdsPeer::start(&opts);
+        let fast = peer.send(&json!({"cmd": "states", "states": states[..1].to_vec(), "warm": states[0], "timeout": 8}));
+        let call = peer.send(&json!({"cmd": "call", "service": "check_states", "type": "check_states", "requests": [{"states": states}], "timeout": 5}));
+        peer.quit();
+        (cyclone.join().unwrap_or_else(|e| std::panic::resume_unwind(e)), fast, call)
+    });
+    eprintln!("peers in host B done in {:.1} s", t.elapsed().as_secs_f64());
+    assert!(node.try_wait().unwrap().is_none(), "the node must run while the peers try");
     let (status, _rest, err) = stop(node, out);
     assert!(status.success(), "node exit {status:?}; stderr: {err}");
     assert_eq!(answer["matched"], false, "OFF: the peer in host B matched the node: {answer}");
     assert_eq!(answer["reports"], json!([]), "OFF: reports reached host B: {answer}");
     assert_eq!(answer["service"], json!([]), "OFF: check_states answered across the link: {answer}");
+    assert_eq!((&fast["matched"], &fast["warm_reports"], &fast["reports"]), (&json!(false), &json!(0), &json!([])), "OFF: Fast DDS: {fast}");
+    assert_eq!(call["matched"], false, "OFF: Fast DDS's check_states client matched the node: {call}");
+    assert!(call["answers"].as_array().is_none_or(|a| a.iter().all(|x| x["response"].is_null())), "OFF: Fast DDS got an answer: {call}");
 }
