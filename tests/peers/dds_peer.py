@@ -97,14 +97,26 @@ def collect(n, wait):
 
 node = req.get("node")
 if node and req.get("set_thickness") is not None:
-    g = call(dp, f"{node}/get_parameters", GetReq, GetResp, GetReq(names=["default_thickness", "world_frame"]))
+    # The parameter services follow the node's service_mapping (cyclone by default): Cyclone's
+    # (guid, seq) header before the fields, as `ros2 param` on rmw_cyclonedds_cpp sends it.
+    if req.get("service_mapping") == "enhanced":
+        pget = lambda names: call(dp, f"{node}/get_parameters", GetReq, GetResp, GetReq(names=names))  # noqa: E731
+        pset = lambda ps: call(dp, f"{node}/set_parameters", SetReq, SetResp, SetReq(parameters=ps))  # noqa: E731
+    else:
+        GetReqCy, GetRespCy = (_types._with_header(f"rcl_interfaces/srv/GetParameters_{k}", c) for k, c in (("Request", GetReq), ("Response", GetResp)))
+        SetReqCy, SetRespCy = (_types._with_header(f"rcl_interfaces/srv/SetParameters_{k}", c) for k, c in (("Request", SetReq), ("Response", SetResp)))
+        pget = lambda names: call(dp, f"{node}/get_parameters", GetReqCy, GetRespCy, None,  # noqa: E731
+                                  make=lambda k: GetReqCy(guid=0x5EED, seq=k + 1, names=names))
+        pset = lambda ps: call(dp, f"{node}/set_parameters", SetReqCy, SetRespCy, None,  # noqa: E731
+                               make=lambda k: SetReqCy(guid=0x5EED, seq=k + 1, parameters=ps))
+    g = pget(["default_thickness", "world_frame"])
     out["get_before"] = None if g is None else [g.values[0].double_value, g.values[1].string_value]
     res = []
     for value in [-1.0, req["set_thickness"]]:  # a bad value first: refused, nothing changes
-        sresp = call(dp, f"{node}/set_parameters", SetReq, SetResp, SetReq(parameters=[Parameter(name="default_thickness", value=pv_double(value))]))
+        sresp = pset([Parameter(name="default_thickness", value=pv_double(value))])
         res.append(None if sresp is None else [bool(sresp.results[0].successful), sresp.results[0].reason])
     out["set_results"] = res
-    g = call(dp, f"{node}/get_parameters", GetReq, GetResp, GetReq(names=["default_thickness"]))
+    g = pget(["default_thickness"])
     out["get_after"] = None if g is None else g.values[0].double_value
 
 if req.get("robot_descriptions"):
