@@ -103,7 +103,8 @@ pub struct Checker {
     params: Params,
     robot: RobotModel,
     targets: Vec<LinkTargets>,
-    scene: Scene,
+    /// Shared by the checkers that differ only in their self pairs (an SRDF that arrives later).
+    scene: Arc<Scene>,
     summary: BuildSummary,
     base: Isometry3<f64>,
     /// `allowed[target index][object index]`.
@@ -200,6 +201,24 @@ impl Checker {
         Ok(self)
     }
 
+    /// This checker with the allowed collision matrix of SRDF `text` in place of its own: robot,
+    /// targets and scene are shared or copied, not loaded again (an SRDF that arrives on its topic
+    /// after the robot must not cost a second build of a million-cell world).
+    pub fn with_other_semantic(&self, text: &str, source: &str) -> Result<Checker, CheckerError> {
+        let checker = Checker {
+            params: self.params.clone(),
+            robot: self.robot.clone(),
+            targets: self.targets.clone(),
+            scene: Arc::clone(&self.scene),
+            summary: self.summary.clone(),
+            base: self.base,
+            allowed: self.allowed.clone(),
+            motion: self.motion.clone(),
+            self_pairs: SelfPairs::default(),
+        };
+        checker.with_semantic(text, source)
+    }
+
     /// As [`Checker::with_semantic`], in place; on error nothing changes.
     pub fn apply_semantic(&mut self, text: &str, source: &str) -> Result<(), CheckerError> {
         let srdf = Srdf::parse(text, source, &self.robot).map_err(|e| CheckerError::Srdf(e.to_string()))?;
@@ -261,7 +280,7 @@ impl Checker {
         checker.summary.thin_surfaces = scene.objects().iter().filter(|o| o.area().is_some()).count();
         checker.summary.cells = scene.cell_count();
         checker.allowed = checker.targets.iter().map(|t| scene.objects().iter().map(|o| checker.params.is_allowed(&t.name, &o.name)).collect()).collect();
-        checker.scene = scene;
+        checker.scene = Arc::new(scene);
         Ok(checker)
     }
 
@@ -380,7 +399,17 @@ impl Checker {
         summary.build_seconds = started.elapsed().as_secs_f64();
         let base = base_isometry(&params.robot_base_pose);
         let semantic_file = params.robot_semantic_file.clone();
-        let checker = Checker { params, robot, targets, scene, summary, base, allowed, motion: std::sync::OnceLock::new(), self_pairs: SelfPairs::default() };
+        let checker = Checker {
+            params,
+            robot,
+            targets,
+            scene: Arc::new(scene),
+            summary,
+            base,
+            allowed,
+            motion: std::sync::OnceLock::new(),
+            self_pairs: SelfPairs::default(),
+        };
         if semantic_file.is_empty() {
             let mut checker = checker;
             checker.self_pairs = SelfPairs::build(&checker, None);

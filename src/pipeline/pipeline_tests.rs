@@ -300,3 +300,19 @@ fn without_check_motion_the_newest_state_is_checked_and_older_ones_are_stale() {
     assert_eq!((r.report.in_collision, r.report.motion, r.stamp), (false, false, states[2].stamp), "only C is checked: {r:?}");
     assert_eq!(p.skipped().get(&SkipCause::Stale), Some(&2));
 }
+
+#[test]
+fn an_srdf_received_after_the_robot_changes_its_self_pairs_and_shares_its_scene() {
+    let mut p = pipeline(Params::default());
+    let before = p.checker().clone();
+    let n = before.targets().len();
+    p.set_robot_semantic(r#"<robot name="workcell"></robot>"#, "the test").unwrap();
+    let after = p.checker().clone();
+    assert_eq!(after.self_pairs().pairs.len(), n * (n - 1) / 2, "an SRDF that disables nothing checks every pair");
+    assert!(before.self_pairs().pairs.len() < after.self_pairs().pairs.len(), "without an SRDF adjacent pairs are allowed");
+    assert!(std::ptr::eq(before.scene(), after.scene()), "the scene is shared, not built again");
+    // A file naming a link the robot lacks is refused whole, and the pairs stay as they were.
+    let bad = r#"<robot name="workcell"><disable_collisions link1="no_such_link" link2="base_link" reason="Never"/></robot>"#;
+    assert!(p.set_robot_semantic(bad, "the test").is_err());
+    assert_eq!(p.checker().self_pairs().pairs, after.self_pairs().pairs);
+}

@@ -372,8 +372,7 @@ impl Pipeline {
     pub fn set_robot_semantic(&mut self, text: &str, source: &str) -> Result<(), CheckerError> {
         // Kept even when it does not fit this robot: the robot it belongs to may come next.
         self.semantic = Some((text.into(), source.to_owned()));
-        let mut checker = self.build_from_source(self.params().clone())?;
-        crate::limits::contain_panic(|| checker.apply_semantic(text, source)).map_err(CheckerError::Panicked)??;
+        let checker = crate::limits::contain_panic(|| self.checker.with_other_semantic(text, source)).map_err(CheckerError::Panicked)??;
         self.replace(checker);
         Ok(())
     }
