@@ -148,6 +148,16 @@ pub fn read_regular_text(path: &Path, what: &'static str, limit: u64) -> Result<
     })
 }
 
+/// The first line of a parser's message, trimmed and cut to 300 characters: some parsers append
+/// a dump of their state (urdf-rs), and an error is one line.
+pub fn first_line(message: &str) -> String {
+    let line = message.lines().next().unwrap_or("").trim();
+    match line.char_indices().nth(300) {
+        Some((cut, _)) => format!("{}...", &line[..cut]),
+        None => line.to_owned(),
+    }
+}
+
 /// `names` joined with ", ", cut after [`MAX_NAMES_IN_ERROR`] with a count of the rest.
 pub fn name_list<S: AsRef<str>>(names: &[S]) -> String {
     let shown: Vec<&str> = names.iter().take(MAX_NAMES_IN_ERROR).map(AsRef::as_ref).collect();

@@ -109,7 +109,7 @@ pub fn parse_mesh(bytes: &[u8], path: &Path, scale: Vector) -> Result<MeshData, 
             let loader = mesh_loader::Loader::default();
             let scene = contain_panic(|| loader.load_from_slice_with_reader(bytes, path, no_materials))
                 .map_err(|panic| parse(format!("the mesh-loader crate failed on this file ({panic})")))?
-                .map_err(|e| parse(one_line(&e.to_string())))?;
+                .map_err(|e| parse(crate::limits::first_line(&e.to_string())))?;
             let mut data = MeshData::default();
             for mesh in &scene.meshes {
                 let base = data.vertices.len();
@@ -167,15 +167,6 @@ fn scale_checked(data: MeshData, path: &Path) -> Result<MeshData, MeshFileError>
         return Err(parse(format!("the mesh is {across:e} m across after scaling; the smallest size allowed is {:e} m", LENGTH_RANGE[0])));
     }
     Ok(data)
-}
-
-/// The first line of a parser's message, cut to 300 characters: some parsers print their state.
-fn one_line(message: &str) -> String {
-    let line = message.lines().next().unwrap_or("").trim();
-    match line.char_indices().nth(300) {
-        Some((cut, _)) => format!("{}...", &line[..cut]),
-        None => line.to_owned(),
-    }
 }
 
 /// A binary STL: at least the 84-byte header, and either a header that does not start with

@@ -209,15 +209,6 @@ fn isometry(p: &urdf_rs::Pose) -> Isometry3<f64> {
     Isometry3::from_parts(Translation3::new(p.xyz[0], p.xyz[1], p.xyz[2]), rpy(p.rpy.0))
 }
 
-/// The first line of urdf-rs's message, without the debug dump some of its errors append.
-fn urdf_message(message: &str) -> String {
-    let line = message.lines().next().unwrap_or("").trim();
-    match line.char_indices().nth(300) {
-        Some((cut, _)) => format!("{}...", &line[..cut]),
-        None => line.to_owned(),
-    }
-}
-
 /// Attributes that hold numbers, by element; each whitespace-separated word must parse.
 const NUMERIC_ATTRIBUTES: &[(&str, &[&str])] = &[
     ("origin", &["xyz", "rpy"]),
@@ -303,7 +294,7 @@ impl RobotModel {
         check_urdf_tags(text).map_err(malformed)?;
         let urdf = contain_panic(|| urdf_rs::read_from_string(text))
             .map_err(|panic| malformed(format!("urdf-rs failed on this text ({panic})")))?
-            .map_err(|e| malformed(urdf_message(&e.to_string())))?;
+            .map_err(|e| malformed(crate::limits::first_line(&e.to_string())))?;
         let structure = |message: String| ModelError::Structure { file: file.into(), message };
         if urdf.links.is_empty() {
             return Err(structure("the robot has no links".into()));
