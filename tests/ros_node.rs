@@ -9,29 +9,9 @@
 mod common;
 
 use serde_json::{json, Value};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
-use common::{start_node, CYCLONE_LOOPBACK};
-
-/// Runs the Cyclone DDS peer with a loopback-only configuration; returns its JSON answer.
-fn run_dds_peer(cyclone: &std::path::Path, request: &Value) -> Value {
-    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
-    let mut child = Command::new(common::python())
-        .arg(&path)
-        .env("CYCLONEDDS_URI", format!("file://{}", cyclone.display()))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    {
-        use std::io::Write;
-        child.stdin.take().unwrap().write_all(request.to_string().replace("\"NaN\"", "NaN").as_bytes()).unwrap();
-    }
-    let o = child.wait_with_output().unwrap();
-    assert!(o.status.success(), "dds_peer.py: {}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).unwrap()
-}
+use common::start_node;
 
 fn state(k: usize) -> (Vec<&'static str>, Vec<f64>) {
     let names = vec!["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
@@ -44,8 +24,7 @@ fn state(k: usize) -> (Vec<&'static str>, Vec<f64>) {
 fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     let dir = std::env::temp_dir().join(format!("tc_ros_node_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let cyclone = dir.join("cyclone.xml");
-    std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
+    let cyclone = common::cyclone_loopback_file(&dir);
     let domain = 100 + std::process::id() % 50;
     let params = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/params.yaml");
 
@@ -96,7 +75,7 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
         status.lines().find(|l| l.starts_with("VmRSS:")).and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse().ok()).unwrap_or(0)
     };
     let rss_before = rss(node.id());
-    let answer = run_dds_peer(&cyclone, &request);
+    let answer = common::run_cyclone_peer("dds_peer.py", &cyclone, &request.to_string().replace("\"NaN\"", "NaN"));
     assert_eq!(answer["matched"], true, "no DDS match on loopback");
     let rss_after = rss(node.id());
     eprintln!("node RSS: {} KiB before, {} KiB after a 10,000-state burst and the bad messages", rss_before, rss_after);
@@ -184,8 +163,7 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     use thickness_collision::model::Params;
     let dir = std::env::temp_dir().join(format!("tc_ros_node_tf_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let cyclone = dir.join("cyclone.xml");
-    std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
+    let cyclone = common::cyclone_loopback_file(&dir);
     let domain = 150 + std::process::id() % 50;
     let (mut node, _out, banner) = start_node(
         &[
@@ -237,7 +215,7 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     let request = json!({"domain": domain, "ns": "/robot1", "states": [], "tf_states": tf_states, "timeout": 30,
         "clock": 42_000_000_000i64, "markers": true, "service_mapping": "enhanced",
         "service_states": [{"name": ["elbow_joint"], "position": [0.1]}]});
-    let answer = run_dds_peer(&cyclone, &request);
+    let answer = common::run_cyclone_peer("dds_peer.py", &cyclone, &request.to_string().replace("\"NaN\"", "NaN"));
     let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
     assert!(node.wait().unwrap().success());
     let mut err = String::new();
@@ -267,8 +245,7 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
 fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
     let dir = std::env::temp_dir().join(format!("tc_ros_node_desc_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let cyclone = dir.join("cyclone.xml");
-    std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
+    let cyclone = common::cyclone_loopback_file(&dir);
     let domain = 200 + std::process::id() % 30;
     let urdf = common::fat_arm_urdf();
     let fat = dir.join("fat_arm.urdf");
@@ -295,7 +272,7 @@ fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
 
     let request = json!({"domain": domain, "robot_descriptions": ["<robot name='broken'><link name='a'></robot>", urdf],
         "states": states.iter().enumerate().map(|(k, (n, p))| json!({"name": n, "position": p, "stamp": k})).collect::<Vec<_>>(), "timeout": 30});
-    let answer = run_dds_peer(&cyclone, &request);
+    let answer = common::run_cyclone_peer("dds_peer.py", &cyclone, &request.to_string().replace("\"NaN\"", "NaN"));
     let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
     assert!(node.wait().unwrap().success());
     let mut rest = String::new();

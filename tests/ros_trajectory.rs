@@ -8,48 +8,19 @@
 
 mod common;
 
-use common::{start_node, CYCLONE_LOOPBACK};
+use common::start_node;
 use oorandom::Rand64;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 use thickness_collision::checker::Checker;
 use thickness_collision::model::{JointKind, Params};
-
-fn run_trajectory_peer(cyclone: &Path, request: &Value) -> Value {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/trajectory_peer.py");
-    let mut child = Command::new(common::python())
-        .arg(&path)
-        .env("CYCLONEDDS_URI", format!("file://{}", cyclone.display()))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    {
-        use std::io::Write;
-        child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
-    }
-    let o = child.wait_with_output().unwrap();
-    assert!(o.status.success(), "trajectory_peer.py: {}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).unwrap()
-}
 
 fn scratch(name: &str) -> (PathBuf, PathBuf) {
     let dir = std::env::temp_dir().join(format!("tc_ros_trajectory_{name}_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let cyclone = dir.join("cyclone.xml");
-    std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
+    let cyclone = common::cyclone_loopback_file(&dir);
     (dir, cyclone)
-}
-
-fn stop(mut node: std::process::Child) -> String {
-    let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
-    let status = node.wait().unwrap();
-    let mut err = String::new();
-    let _ = std::io::Read::read_to_string(&mut node.stderr.take().unwrap(), &mut err);
-    assert!(status.success(), "node exit {status:?}: {err}");
-    err
 }
 
 /// The bundled arm, the names of its actuated joints, and random states within its limits.
@@ -259,8 +230,12 @@ fn check_trajectory_over_dds_equals_check_motion_and_refuses_bad_requests() {
     let mut trajectories = vec![request_of(&arm.names, &crossing), request_of(&arm.names, &free), request_of(&partial_names, &partial)];
     trajectories.extend(bad.iter().map(|(t, _)| t.clone()));
     let state = json!({"name": arm.names, "position": base, "stamp": 5_000_000_000i64});
-    let answer = run_trajectory_peer(&cyclone, &json!({"domain": domain, "state": state, "trajectories": trajectories, "timeout": 60}));
-    let err = stop(node);
+    let answer = common::run_cyclone_peer(
+        "trajectory_peer.py",
+        &cyclone,
+        &json!({"domain": domain, "state": state, "trajectories": trajectories, "timeout": 60}).to_string(),
+    );
+    let err = common::stop_node(node);
 
     assert!(answer["state_report"].is_object(), "the node reported on the state the trajectory is merged with: {answer}");
     let answers = answer["answers"].as_array().unwrap();
@@ -306,8 +281,12 @@ fn a_long_trajectory_is_checked_while_the_live_stream_goes_on() {
 
     let domain = 15 + std::process::id() % 14;
     let (node, _out, _banner) = start_node(&[], domain);
-    let answer = run_trajectory_peer(&cyclone, &json!({"domain": domain, "long": request_of(&arm.names, &waypoints), "stream": stream, "timeout": 120}));
-    let _ = stop(node);
+    let answer = common::run_cyclone_peer(
+        "trajectory_peer.py",
+        &cyclone,
+        &json!({"domain": domain, "long": request_of(&arm.names, &waypoints), "stream": stream, "timeout": 120}).to_string(),
+    );
+    let _ = common::stop_node(node);
     let long = &answer["long"];
     eprintln!("long trajectory: {long}");
     assert_eq!((&long["answer"]["valid"], &long["answer"]["segment"]), (&json!(true), &json!(-1)), "{long}");

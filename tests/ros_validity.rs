@@ -10,41 +10,13 @@
 
 mod common;
 
-use common::{start_node, CYCLONE_LOOPBACK};
+use common::start_node;
 use oorandom::Rand64;
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::path::Path;
+use std::process::Command;
 use thickness_collision::checker::Checker;
 use thickness_collision::model::{JointKind, Params};
-
-fn run_validity_peer(cyclone: &Path, request: &Value) -> Value {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/validity_peer.py");
-    let mut child = Command::new(common::python())
-        .arg(&path)
-        .env("CYCLONEDDS_URI", format!("file://{}", cyclone.display()))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    {
-        use std::io::Write;
-        child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
-    }
-    let o = child.wait_with_output().unwrap();
-    assert!(o.status.success(), "validity_peer.py: {}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).unwrap()
-}
-
-fn stop(mut node: std::process::Child) -> String {
-    let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
-    let status = node.wait().unwrap();
-    let mut err = String::new();
-    let _ = std::io::Read::read_to_string(&mut node.stderr.take().unwrap(), &mut err);
-    assert!(status.success(), "node exit {status:?}: {err}");
-    err
-}
 
 /// `check --states FILE --json` on states given by name: one report per state.
 fn check_cli(dir: &Path, names: &[String], states: &[Vec<f64>]) -> Vec<Value> {
@@ -86,8 +58,7 @@ fn assert_same(k: usize, got: &Value, cli: &Value) {
 fn check_state_validity_agrees_with_check_and_refuses_what_it_cannot_honour() {
     let dir = std::env::temp_dir().join(format!("tc_ros_validity_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let cyclone = dir.join("cyclone.xml");
-    std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
+    let cyclone = common::cyclone_loopback_file(&dir);
 
     // Random states of the bundled arm within its limits, some free and some not.
     let checker = Checker::from_params(Params::default(), None, None).unwrap();
@@ -145,8 +116,12 @@ fn check_state_validity_agrees_with_check_and_refuses_what_it_cannot_honour() {
     let domain = 230 + std::process::id() % 3;
     let (node, _out, banner) = start_node(&["--ros-args", "-p", "check_motion:=false"], domain);
     assert!(banner.contains("check_state_validity (moveit_msgs/srv/GetStateValidity)"), "{banner}");
-    let answer = run_validity_peer(&cyclone, &json!({"domain": domain, "requests": requests, "timeout": 90, "refused_at_least": bad.len()}));
-    let err = stop(node);
+    let answer = common::run_cyclone_peer(
+        "validity_peer.py",
+        &cyclone,
+        &json!({"domain": domain, "requests": requests, "timeout": 90, "refused_at_least": bad.len()}).to_string(),
+    );
+    let err = common::stop_node(node);
 
     let answers = answer["answers"].as_array().unwrap();
     assert_eq!(answers.len(), requests.len());

@@ -5,7 +5,7 @@
 pub mod fastdds;
 
 use std::io::{BufRead, BufReader, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, Stdio};
 
 pub mod netns;
@@ -78,13 +78,44 @@ pub fn python() -> PathBuf {
 
 /// Runs a peer script from `tests/peers/` with a JSON request on stdin; returns its JSON answer.
 pub fn run_peer(script: &str, request: &serde_json::Value) -> serde_json::Value {
+    run_peer_env(script, &[], &request.to_string())
+}
+
+/// A Cyclone DDS peer from `tests/peers/` configured by the file `cyclone` (`CYCLONEDDS_URI`),
+/// with `request` (JSON text: it may hold bare `NaN`s) on stdin; returns its JSON answer.
+pub fn run_cyclone_peer(script: &str, cyclone: &Path, request: &str) -> serde_json::Value {
+    run_peer_env(script, &[("CYCLONEDDS_URI", format!("file://{}", cyclone.display()))], request)
+}
+
+fn run_peer_env(script: &str, env: &[(&str, String)], request: &str) -> serde_json::Value {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers").join(script);
-    let mut child =
-        Command::new(python()).arg(&path).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("start the Python peer");
-    child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
+    let mut command = Command::new(python());
+    let _ = command.arg(&path).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped());
+    for (k, v) in env {
+        let _ = command.env(k, v);
+    }
+    let mut child = command.spawn().expect("start the Python peer");
+    child.stdin.take().unwrap().write_all(request.as_bytes()).unwrap();
     let out = child.wait_with_output().unwrap();
     assert!(out.status.success(), "{script} failed: {}", String::from_utf8_lossy(&out.stderr));
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{script} answered no JSON: {e}"))
+}
+
+/// [`CYCLONE_LOOPBACK`] written to `dir/cyclone.xml`, for a peer's `CYCLONEDDS_URI`.
+pub fn cyclone_loopback_file(dir: &Path) -> PathBuf {
+    let file = dir.join("cyclone.xml");
+    std::fs::write(&file, CYCLONE_LOOPBACK).unwrap();
+    file
+}
+
+/// Stops a node with SIGTERM, asserts that it exited cleanly, and returns its standard error.
+pub fn stop_node(mut node: Child) -> String {
+    let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
+    let status = node.wait().unwrap();
+    let mut err = String::new();
+    let _ = std::io::Read::read_to_string(&mut node.stderr.take().unwrap(), &mut err);
+    assert!(status.success(), "node exit {status:?}: {err}");
+    err
 }
 
 /// `<site-packages>/cmeel.prefix/share/example-robot-data`, where example-robot-data installs.
