@@ -86,8 +86,8 @@ out = pathlib.Path(out)
 names = {"node": "thickness_collision node", "rust": "Rust relay (ros2-client)", "cpp": "C++ relay (Fast DDS)"}
 print(f"{seconds} s per rate after 1 s of warm-up; {network}; load average before {lb}, after {la}; "
       f"{'sender on CPU 0, answerer on CPU 1' if pin == '1' else 'not pinned'}\n")
-print("| rate | answerer | round | answered / sent | covered | median (µs) | p99 (µs) | p99.9 (µs) | max (µs) | late sends |")
-print("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+print("| rate | answerer | round | answered / sent | covered | median (µs) | p99 (µs) | p99.9 (µs) | max (µs) | late sends (> half a period) | check_seconds median / p99 (µs) |")
+print("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
 rows = {}
 for rate in (1000, 10000):
     for r in range(1, int(rounds) + 1):
@@ -96,7 +96,8 @@ for rate in (1000, 10000):
             rows[(rate, who, r)] = j
             pc = 100.0 * j["answered"] / j["sent"]
             print(f"| {rate // 1000} kHz | {names[who]} | {r} | {j['answered']:,} / {j['sent']:,} ({pc:.2f} %) | {j['covered']:,} | "
-                  + " | ".join(f"{j[k]:.0f}" if j[k] >= 0 else "-" for k in ("median_us", "p99_us", "p999_us", "max_us")) + f" | {j['late_sends']} |")
+                  + " | ".join(f"{j[k]:.0f}" if j[k] >= 0 else "-" for k in ("median_us", "p99_us", "p999_us", "max_us")) + f" | {j['late_sends']} | "
+                  + (f"{j['check_median_us']:.0f} / {j['check_p99_us']:.0f}" if who == "node" and j["check_median_us"] >= 0 else "-") + " |")
 if "node" in only and "cpp" in only:
     print()
     for r in range(1, int(rounds) + 1):

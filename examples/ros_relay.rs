@@ -38,7 +38,8 @@ fn run() -> Result<(), String> {
             // The node's QoS: joint_states best effort keep last 100, collisions reliable keep last 100.
             let best_effort = QosProfile::subscription_default().reliability_best_effort().history(History::KeepLast { depth: 100 });
             let reliable = QosProfile::publisher_default().reliability_reliable(WhenFull::DEFAULT).history(History::KeepLast { depth: 100 });
-            let js = node.create_topic(&name("joint_states")?, MessageTypeName::new("sensor_msgs", "JointState"), &best_effort).map_err(|e| format!("{e:?}"))?;
+            let js =
+                node.create_topic(&name("joint_states")?, MessageTypeName::new("sensor_msgs", "JointState"), &best_effort).map_err(|e| format!("{e:?}"))?;
             let out = node
                 .create_topic(&name("collisions")?, MessageTypeName::new("thickness_collision_msgs", "CollisionReport"), &reliable)
                 .map_err(|e| format!("{e:?}"))?;

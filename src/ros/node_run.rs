@@ -20,7 +20,7 @@ use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionRepo
 use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause, TrajectoryJob};
 use anyhow::{anyhow, Context as _, Result};
 use futures::stream::FusedStream;
-use futures::{FutureExt, StreamExt};
+use futures::StreamExt;
 use ros2_client::dds::rustdds::{DomainParticipant, DomainParticipantBuilder};
 use ros2_client::qos::{History, WhenFull};
 use ros2_client::{
@@ -353,6 +353,9 @@ const MAX_STATES_PER_TURN: usize = 256;
 /// Joint states the reader keeps while the node is busy.
 const STATES_KEPT: usize = 100;
 
+/// The loop's housekeeping period (`/rosout`, `/diagnostics`, the summary for a forced stop).
+const TICK: Duration = Duration::from_millis(100);
+
 /// How long a stop request waits for the loop (busy building a robot, say) before the process
 /// exits without it: SIGTERM is honoured within 2 s whatever the loop is doing. (Exiting is not
 /// instant either: a process holding gigabytes took 0.6 s to be torn down.)
@@ -440,6 +443,7 @@ impl NodeState {
             newest = Some(params);
         }
         if let Some(params) = newest {
+            self.refresh_summary();
             match self.pipeline.set_params(params) {
                 Ok(()) => {
                     let s = self.pipeline.checker().summary();
@@ -517,6 +521,7 @@ impl NodeState {
     /// one leaves the current robot running, is warned about (every one: descriptions are rare)
     /// and sets `/diagnostics` to ERROR with the reason until a good one arrives.
     fn on_description(&mut self, io: &Interfaces, msg: DescriptionMsg) {
+        self.refresh_summary();
         let source = format!("{} topic", io.names.description);
         let result = match msg {
             DescriptionMsg::Text(text) => self.pipeline.set_robot_description(&text, &source).map_err(|e| e.to_string()),
@@ -545,6 +550,7 @@ impl NodeState {
     /// one (it names links or joints the robot lacks) leaves the current matrix, as a refused
     /// description does.
     fn on_semantic(&mut self, io: &Interfaces, msg: DescriptionMsg) {
+        self.refresh_summary();
         let source = format!("{} topic", io.names.semantic);
         let result = match msg {
             DescriptionMsg::Text(text) => self.pipeline.set_robot_semantic(&text, &source).map_err(|e| e.to_string()),
@@ -679,6 +685,12 @@ impl NodeState {
                 self.log.warn("diagnostics", || "publishing /diagnostics failed".into());
             }
         }
+        self.refresh_summary();
+    }
+
+    /// The summary a forced stop prints: refreshed each tick and before a turn that may be long
+    /// (a robot or SRDF to build), not per input.
+    fn refresh_summary(&self) {
         let line = self.shutdown_line();
         if let Ok(mut summary) = self.summary.lock() {
             *summary = line;
@@ -792,10 +804,16 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let mut validity_requests = io.check_state_validity.receive_request_stream();
         let mut checked_validity = Box::pin(validity_worker.done.clone());
         let mut param_requests: ParamRequests = param_servers.as_ref().map_or_else(|| Box::pin(futures::stream::pending()), ParamServers::requests);
+        // One timer for the whole run (issue 14): a fresh smol Timer per turn was registered with
+        // the reactor, and woke it, for every message. The housekeeping (/rosout, /diagnostics,
+        // the summary for a forced stop) runs when the tick has come or is overdue, not per input.
+        let mut tick = smol::Timer::interval(TICK).fuse();
+        let (mut tick_due, mut last_tick) = (true, Instant::now());
         while !stop.load(Ordering::SeqCst) {
-            state.on_tick(&node, &io);
-            let tick = FutureExt::fuse(smol::Timer::after(Duration::from_millis(100)));
-            futures::pin_mut!(tick);
+            if std::mem::take(&mut tick_due) || last_tick.elapsed() >= TICK {
+                last_tick = Instant::now();
+                state.on_tick(&node, &io);
+            }
             let event = futures::select! {
                 m = states.select_next_some() => m.map_or_else(|e| Event::ReadFailed("joint_states", e), |(m, _)| Event::States(m)),
                 m = tfs.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/tf", e), |(m, _)| Event::Tf(m)),
@@ -809,7 +827,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 r = validity_requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_state_validity", e), |(id, req)| Event::ValidityRequest(id, Box::new(req))),
                 (id, answer, reason) = checked_validity.select_next_some() => Event::ValidityDone(id, answer, reason),
                 r = param_requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("parameter services", e), Event::Parameter),
-                _ = tick => Event::Tick,
+                _ = tick.select_next_some() => Event::Tick,
             };
             // A parameter change accepted before this input arrived applies to it.
             state.apply_params(&io, &changes);
@@ -833,7 +851,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                         }
                     }
                 }
-                Event::Tick => {}
+                Event::Tick => tick_due = true,
             }
         }
         if printed.compare_exchange(false, true, Ordering::SeqCst, Ordering::SeqCst).is_ok() {

@@ -1583,7 +1583,11 @@ impl Writer {
                                          * set of reader proxies */
   ) {
     // Decide the (max) number of frags to be sent
-    let max_send_count = 8;
+    // thickness_collision patch: 256 fragments (64 KiB) a round, not 8 (2 KiB): with 256-byte
+    // fragments and a round every REPAIR_INTERVAL_DEFAULT (10 ms), 8 capped the repair of a
+    // large sample to ~200 KB/s (a late joiner waited 7 s for 1.2 MB of latched markers). 256 is
+    // what one NACKFRAG's bitmap can ask for.
+    let max_send_count = 256;
 
     let reader_guid = reader_proxy.remote_reader_guid;
 
