@@ -88,6 +88,7 @@ fn main() {
             // measured in benches/motion.rs.
             motion: Some(false),
             plot: None,
+            no_markers: true,
         };
         let started = Instant::now();
         let summary = replay(Params::default(), None, None, &opts).unwrap();

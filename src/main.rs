@@ -96,6 +96,10 @@ enum Command {
         /// markers, `/tf` and `/robot_description` (to open beside the input in Foxglove or RViz).
         #[arg(long = "out")]
         out_dir: Option<PathBuf>,
+        /// The output bag gets `/collisions` only (no markers, `/tf` or `/robot_description`):
+        /// a tenth of the size for joint-state input.
+        #[arg(long, requires = "out_dir")]
+        no_markers: bool,
         /// Draw the collision timeline (one row per link, a bar per interval in collision) into
         /// this SVG file.
         #[arg(long)]
@@ -162,7 +166,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         #[cfg(feature = "ros")]
         Command::Run { model, ros_args } => cli::run::run(&model, &ros_args),
-        Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, plot, jsonl, start, end, motion, no_motion } => {
+        Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, no_markers, plot, jsonl, start, end, motion, no_motion } => {
             let motion = if motion {
                 Some(true)
             } else if no_motion {
@@ -170,8 +174,20 @@ fn run(cli: Cli) -> Result<()> {
             } else {
                 None
             };
-            let opts =
-                thickness_collision::replay::ReplayOptions { bag, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, progress: true, motion, plot };
+            let opts = thickness_collision::replay::ReplayOptions {
+                bag,
+                topic,
+                pose_source,
+                frame_prefix,
+                out_dir,
+                jsonl,
+                start,
+                end,
+                progress: true,
+                motion,
+                plot,
+                no_markers,
+            };
             cli::replay::replay(&model, &opts)
         }
     }

@@ -234,31 +234,41 @@ impl Pipeline {
     }
 
     /// The world pose of every link of a joint state (forward kinematics, as the check computed
-    /// them) as a `/tf` message: `world_frame` to each link's frame (`frame_prefix` + name), stamped
-    /// with the state. `None` for a state made of link poses (its `/tf` came with the input).
-    pub fn link_transforms(&self, state: &RobotState) -> Option<TfMessage> {
-        let StatePose::Joints(q) = &state.pose else { return None };
+    /// them) as a `/tf` message into `out`: `world_frame` to each link's frame (`frame_prefix` +
+    /// name), stamped with the state. False (and `out` untouched) for a state made of link poses:
+    /// its `/tf` came with the input.
+    ///
+    /// The frame names already in `out` are kept (a replay writing one message per state then
+    /// allocates no strings): pass an empty message after the checker changed
+    /// ([`Pipeline::checker`] is another `Arc`), or the names may be another robot's.
+    pub fn link_transforms(&self, state: &RobotState, out: &mut TfMessage) -> bool {
+        let StatePose::Joints(q) = &state.pose else { return false };
         let robot = self.checker.robot();
         // A state this pipeline accepted has a position for every joint: FK cannot fail on it.
-        let poses = robot.forward_kinematics(q, self.checker.base_pose()).ok()?;
+        let Ok(poses) = robot.forward_kinematics(q, self.checker.base_pose()) else { return false };
         let (world, prefix) = (&self.params().world_frame, &self.params().frame_prefix);
-        let transforms = robot
-            .links
-            .iter()
-            .zip(&poses)
-            .map(|(link, pose)| (format!("{prefix}{}", link.name), pose))
-            // A root link named like the world frame would be its own parent.
-            .filter(|(frame, _)| frame != world)
-            .map(|(child_frame_id, pose)| {
-                let (t, r) = (pose.translation.vector, pose.rotation.coords);
-                TransformStamped {
+        // A root link named like the world frame would be its own parent.
+        let own = world.strip_prefix(prefix.as_str()).and_then(|name| robot.link(name));
+        let links = robot.links.iter().zip(&poses).enumerate().filter(|(i, _)| Some(*i) != own).map(|(_, l)| l);
+        let mut n = 0;
+        for (link, pose) in links {
+            // The length alone is compared: comparing the names cost 7 % of a replay.
+            if out.transforms.get(n).is_none_or(|t| t.child_frame_id.len() != prefix.len() + link.name.len()) {
+                out.transforms.truncate(n);
+                out.transforms.push(TransformStamped {
                     header: Header { stamp: state.stamp, frame_id: world.clone() },
-                    child_frame_id,
-                    transform: Transform { translation: Vector3 { x: t.x, y: t.y, z: t.z }, rotation: Quaternion { x: r.x, y: r.y, z: r.z, w: r.w } },
-                }
-            })
-            .collect();
-        Some(TfMessage { transforms })
+                    child_frame_id: format!("{prefix}{}", link.name),
+                    transform: Transform::default(),
+                });
+            }
+            let (t, r) = (pose.translation.vector, pose.rotation.coords);
+            let entry = &mut out.transforms[n];
+            entry.header.stamp = state.stamp;
+            entry.transform = Transform { translation: Vector3 { x: t.x, y: t.y, z: t.z }, rotation: Quaternion { x: r.x, y: r.y, z: r.z, w: r.w } };
+            n += 1;
+        }
+        out.transforms.truncate(n);
+        true
     }
 
     /// The URDF text of the robot in force, for viewers that draw it: the `robot_description`

@@ -1,6 +1,7 @@
 //! Writing a rosbag2 bag: a directory with `metadata.yaml` and one `.mcap` file.
 
-use super::cdr::encode_cdr_le;
+use super::cdr::encode_cdr_le_into;
+use super::cdr_writer::CdrWriter;
 use crate::msgs::full_definition;
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -34,6 +35,8 @@ pub struct BagWriter {
     topics: Vec<TopicEntry>,
     first: Option<i64>,
     last: i64,
+    /// The message being encoded, reused.
+    buf: Vec<u8>,
 }
 
 impl BagWriter {
@@ -48,7 +51,7 @@ impl BagWriter {
         let file = std::fs::File::create(dir.join(&file_name)).with_context(|| format!("cannot create {}", dir.join(&file_name).display()))?;
         // Uncompressed, as `ros2 bag record` writes MCAP by default; zstd cost ~15 % of a replay.
         let writer = mcap::WriteOptions::new().profile("ros2").library("thickness_collision").compression(None).create(BufWriter::new(file))?;
-        Ok(BagWriter { dir: dir.to_owned(), file_name, writer, schemas: BTreeMap::new(), topics: Vec::new(), first: None, last: 0 })
+        Ok(BagWriter { dir: dir.to_owned(), file_name, writer, schemas: BTreeMap::new(), topics: Vec::new(), first: None, last: 0, buf: Vec::new() })
     }
 
     /// Adds a topic of a type this crate has the full definition of (`crate::msgs::full_definition`);
@@ -73,7 +76,21 @@ impl BagWriter {
 
     /// Appends one message received at `log_time` (nanoseconds).
     pub fn write<T: Serialize>(&mut self, topic: TopicId, msg: &T, log_time: i64) -> Result<()> {
-        self.write_raw(topic, &encode_cdr_le(msg), log_time)
+        let mut buf = std::mem::take(&mut self.buf);
+        encode_cdr_le_into(&mut buf, msg);
+        let written = self.write_raw(topic, &buf, log_time);
+        self.buf = buf;
+        written
+    }
+
+    /// Appends one message encoded by `encode` (a [`super::cdr_writer::CdrWriter`] method) into the
+    /// writer's reused buffer.
+    pub(super) fn write_with(&mut self, topic: TopicId, encode: impl FnOnce(CdrWriter), log_time: i64) -> Result<()> {
+        let mut buf = std::mem::take(&mut self.buf);
+        encode(CdrWriter::new(&mut buf));
+        let written = self.write_raw(topic, &buf, log_time);
+        self.buf = buf;
+        written
     }
 
     /// Appends one message already in CDR (with its encapsulation header), as copied from a bag.

@@ -39,13 +39,21 @@ pub fn decode_cdr<T: DeserializeOwned>(data: &[u8]) -> Result<T, CdrError> {
 
 /// Encodes a message as little-endian CDR with its encapsulation header.
 pub fn encode_cdr_le<T: Serialize>(msg: &T) -> Vec<u8> {
-    let mut out = vec![0x00, 0x01, 0x00, 0x00];
-    // Serialising our own plain structs into a Vec cannot fail.
-    match cdr_encoding::to_vec::<T, byteorder::LittleEndian>(msg) {
-        Ok(body) => out.extend_from_slice(&body),
-        Err(e) => unreachable!("CDR serialisation of an in-memory message failed: {e}"),
-    }
+    let mut out = Vec::new();
+    encode_cdr_le_into(&mut out, msg);
     out
+}
+
+/// As [`encode_cdr_le`], into `out` (cleared first): a writer that reuses one buffer allocates
+/// nothing per message.
+pub fn encode_cdr_le_into<T: Serialize>(out: &mut Vec<u8>, msg: &T) {
+    out.clear();
+    out.extend_from_slice(&[0x00, 0x01, 0x00, 0x00]);
+    // Alignment counts from the first byte the serialiser writes, after the header, as CDR wants.
+    // Serialising our own plain structs into a Vec cannot fail.
+    if let Err(e) = cdr_encoding::to_writer::<T, byteorder::LittleEndian, _>(&mut *out, msg) {
+        unreachable!("CDR serialisation of an in-memory message failed: {e}")
+    }
 }
 
 #[cfg(test)]

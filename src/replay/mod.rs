@@ -2,9 +2,11 @@
 //! joint states (or `/tf`) in, one collision report per state out, as JSON lines, as a new rosbag2
 //! bag with the `collisions` topic, markers and the robot for viewers, and/or as a timeline SVG.
 
+mod bag_output;
 mod bag_reader;
 mod bag_writer;
 mod cdr;
+mod cdr_writer;
 mod replay_run;
 mod timeline;
 mod timeline_svg;

@@ -3,14 +3,13 @@
 //! rosbag2 bag (the report, its markers and the robot's poses) and/or a bar of the timeline. The
 //! bag is streamed: memory is bounded by the model, not the recording.
 
+use super::bag_output::{OutputBag, DESCRIPTION_TOPIC};
 use super::bag_reader::{open_bag, BagMessage};
-use super::bag_writer::{BagWriter, TopicId};
 use super::cdr::decode_cdr;
 use super::timeline::Timeline;
 use super::timeline_svg::timeline_svg;
-use crate::markers::{cell_markers, contact_markers};
 use crate::model::{Params, PoseSource};
-use crate::msgs::{DurationMsg, JointState, StringMsg, TfMessage, Time, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};
+use crate::msgs::{JointState, StringMsg, TfMessage};
 use crate::pipeline::{CheckedState, Pipeline, RobotState, Skip, SkipCause};
 use anyhow::{bail, Context, Result};
 use std::collections::{BTreeMap, HashSet};
@@ -18,8 +17,6 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// The topic a `robot_description` is recorded on.
-const DESCRIPTION_TOPIC: &str = "/robot_description";
 const SEMANTIC_TOPIC: &str = "/robot_description_semantic";
 
 /// What to replay and where the results go.
@@ -47,6 +44,8 @@ pub struct ReplayOptions {
     pub motion: Option<bool>,
     /// Draw the collision timeline into this SVG file.
     pub plot: Option<PathBuf>,
+    /// The output bag gets `/collisions` only: no markers, `/tf` or `/robot_description`.
+    pub no_markers: bool,
 }
 
 /// What a replay did.
@@ -120,83 +119,6 @@ struct Outputs {
     plot: Option<(Timeline, PathBuf)>,
 }
 
-/// The output bag and its topics: what a viewer needs to draw the recording beside its reports.
-struct OutputBag {
-    writer: BagWriter,
-    collisions: TopicId,
-    contacts: TopicId,
-    cells: TopicId,
-    description: TopicId,
-    tf: TopicId,
-    tf_static: TopicId,
-    /// The input is `/tf`: it is copied (with `/tf_static`). For joint states the poses the check
-    /// computed are written instead, and a `/tf` recorded beside them is not copied: the same
-    /// link frames would get a second parent.
-    copy_tf: bool,
-    /// The input has a `/robot_description`: it is copied, and the robot's file is not written.
-    copy_description: bool,
-    /// The cells (and the robot's file) are written with the first message.
-    started: bool,
-}
-
-impl OutputBag {
-    fn create(dir: &Path, input_topics: &[(String, String)], pose_source: PoseSource) -> Result<OutputBag> {
-        let mut writer = BagWriter::create(dir)?;
-        let has = |topic: &str, ty: &str| input_topics.iter().any(|(t, y)| t == topic && (y.is_empty() || y == ty));
-        Ok(OutputBag {
-            collisions: writer.add_topic("/collisions", COLLISION_REPORT_TYPE, false)?,
-            contacts: writer.add_topic("/collision_markers/contacts", MARKER_ARRAY_TYPE, false)?,
-            cells: writer.add_topic("/collision_markers/cells", MARKER_ARRAY_TYPE, true)?,
-            description: writer.add_topic(DESCRIPTION_TOPIC, STRING_TYPE, true)?,
-            tf: writer.add_topic("/tf", TF_MESSAGE_TYPE, false)?,
-            tf_static: writer.add_topic("/tf_static", TF_MESSAGE_TYPE, true)?,
-            copy_tf: pose_source == PoseSource::Tf,
-            copy_description: has(DESCRIPTION_TOPIC, STRING_TYPE),
-            writer,
-            started: false,
-        })
-    }
-
-    /// Before the first message: the cells once, at the bag's start, and the robot's URDF when the
-    /// bag has none of its own.
-    fn start(&mut self, pipeline: &Pipeline, log_time: i64) -> Result<()> {
-        self.started = true;
-        let params = pipeline.params();
-        let cells = cell_markers(pipeline.checker(), params.marker_max_cells.max(0) as usize, &params.world_frame, Time::from_nanos(log_time));
-        self.writer.write(self.cells, &cells, log_time)?;
-        if !self.copy_description {
-            let urdf = pipeline.robot_urdf().context("the robot's URDF for /robot_description in the output bag")?;
-            self.writer.write(self.description, &StringMsg { data: urdf }, log_time)?;
-        }
-        Ok(())
-    }
-
-    /// Copies the input's `/tf`, `/tf_static` and `/robot_description` messages as they are.
-    fn copy(&mut self, m: &BagMessage) -> Result<()> {
-        let topic = match m.topic.as_str() {
-            "/tf" if self.copy_tf => self.tf,
-            "/tf_static" if self.copy_tf => self.tf_static,
-            DESCRIPTION_TOPIC if self.copy_description => self.description,
-            _ => return Ok(()),
-        };
-        self.writer.write_raw(topic, &m.data, m.log_time)
-    }
-
-    /// A report, its contact markers and (for joint states) the link poses it was checked at.
-    fn report(&mut self, pipeline: &Pipeline, state: &RobotState, checked: &CheckedState, log_time: i64) -> Result<()> {
-        let frame = &pipeline.params().world_frame;
-        self.writer.write(self.collisions, &checked.message(frame), log_time)?;
-        // Lifetime zero: each report's DELETEALL replaces the one before, however far apart.
-        self.writer.write(self.contacts, &contact_markers(&checked.report, frame, checked.stamp, DurationMsg::default()), log_time)?;
-        if !self.copy_tf {
-            if let Some(tf) = pipeline.link_transforms(state) {
-                self.writer.write(self.tf, &tf, log_time)?;
-            }
-        }
-        Ok(())
-    }
-}
-
 /// Replays a bag. Reports before a corrupt tail are kept; the fault is in the summary and makes
 /// the result an error after the outputs are written.
 pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, opts: &ReplayOptions) -> Result<ReplaySummary> {
@@ -252,7 +174,7 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
         },
         jsonl_path: opts.jsonl.clone(),
         bag: match &opts.out_dir {
-            Some(d) => Some(OutputBag::create(d, bag.topics(), pose_source)?),
+            Some(d) => Some(OutputBag::create(d, bag.topics(), pose_source, &pipeline.params().world_frame, !opts.no_markers)?),
             None => None,
         },
         plot: match &opts.plot {
@@ -296,10 +218,7 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
         let t0 = *t0.get_or_insert(m.log_time);
         let seconds = (m.log_time - t0) as f64 * 1e-9;
         if let Some(b) = out.bag.as_mut() {
-            if !b.started {
-                b.start(&pipeline, m.log_time)?;
-            }
-            b.copy(&m)?;
+            b.input(&pipeline, &m)?;
         }
         let in_window = opts.start.is_none_or(|a| seconds >= a) && opts.end.is_none_or(|b| seconds <= b);
         let state = if m.topic == DESCRIPTION_TOPIC {
@@ -335,7 +254,7 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
                 // One state per report, as the node gives when it keeps up.
                 let Some(checked) = pipeline.check_path(std::slice::from_ref(&state)) else { continue };
                 record(&mut summary, &checked);
-                write_outputs(&mut out, &pipeline, &state, &checked, m.log_time, seconds)?;
+                write_outputs(&mut out, &pipeline, &state, checked, m.log_time, seconds)?;
             }
             Ok(None) => {}
             Err(Skip { cause, message }) => {
@@ -350,7 +269,7 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
         w.flush().with_context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(b) = out.bag {
-        let _ = b.writer.finish()?;
+        b.finish()?;
     }
     if let Some((timeline, path)) = &out.plot {
         let svg = timeline_svg(timeline, &opts.bag.display().to_string()).map_err(anyhow::Error::msg)?;
@@ -419,12 +338,9 @@ fn record(summary: &mut ReplaySummary, checked: &CheckedState) {
     }
 }
 
-fn write_outputs(out: &mut Outputs, pipeline: &Pipeline, state: &RobotState, checked: &CheckedState, log_time: i64, seconds: f64) -> Result<()> {
+fn write_outputs(out: &mut Outputs, pipeline: &Pipeline, state: &RobotState, checked: CheckedState, log_time: i64, seconds: f64) -> Result<()> {
     if let (Some(w), Some(path)) = (out.jsonl.as_mut(), &out.jsonl_path) {
         w.write_all(checked.json().as_bytes()).and_then(|()| w.write_all(b"\n")).with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    if let Some(b) = out.bag.as_mut() {
-        b.report(pipeline, state, checked, log_time)?;
     }
     if let Some((timeline, _)) = out.plot.as_mut() {
         // A motion in collision may have met something only between the two states: the state's
@@ -432,6 +348,9 @@ fn write_outputs(out: &mut Outputs, pipeline: &Pipeline, state: &RobotState, che
         let own = (checked.report.motion && checked.report.in_collision)
             .then(|| pipeline.check(state).report.contacts.into_iter().map(|c| c.link_name).collect::<std::collections::HashSet<_>>());
         timeline.record(seconds, &checked.report, own.as_ref());
+    }
+    if let Some(b) = out.bag.as_mut() {
+        b.report(pipeline, state, checked, log_time)?;
     }
     Ok(())
 }

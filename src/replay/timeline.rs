@@ -108,32 +108,34 @@ impl Timeline {
                     &mut self.rows[last]
                 }
             };
-            let fresh = TimelineBar {
-                start: seconds,
-                end: seconds,
-                states: (n, n),
-                colliding: 1,
-                state_hits: state_hit as u64,
-                depth: c.depth,
-                objects: BTreeSet::from([c.object_name.clone()]),
-                runs: 1,
-            };
             match row.bars.last_mut() {
                 // A second contact of the same link in the same report.
-                Some(b) if b.states.1 == n => {
-                    b.depth = b.depth.max(c.depth);
-                    let _ = b.objects.insert(c.object_name.clone());
-                }
-                Some(b) if b.states.1 + 1 == n => {
+                Some(b) if b.states.1 == n => b.depth = b.depth.max(c.depth),
+                // The run goes on; or, once bars are merged to bound memory, a close one joins.
+                Some(b) if b.states.1 + 1 == n || seconds - b.end < row.merged_within => {
+                    b.runs += (b.states.1 + 1 != n) as u64;
                     b.end = seconds;
                     b.states.1 = n;
                     b.colliding += 1;
                     b.state_hits += state_hit as u64;
                     b.depth = b.depth.max(c.depth);
+                }
+                _ => row.bars.push(TimelineBar {
+                    start: seconds,
+                    end: seconds,
+                    states: (n, n),
+                    colliding: 1,
+                    state_hits: state_hit as u64,
+                    depth: c.depth,
+                    objects: BTreeSet::new(),
+                    runs: 1,
+                }),
+            }
+            // Most contacts extend a bar that already names their object: no string is cloned.
+            if let Some(b) = row.bars.last_mut() {
+                if !b.objects.contains(&c.object_name) {
                     let _ = b.objects.insert(c.object_name.clone());
                 }
-                Some(b) if seconds - b.end < row.merged_within => b.absorb(fresh),
-                _ => row.bars.push(fresh),
             }
             if row.bars.len() > MAX_BARS_KEPT {
                 row.coarsen();

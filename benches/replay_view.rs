@@ -1,0 +1,139 @@
+//! Issue 16's figure: a one-hour bag at 100 Hz (360,000 random joint states of the bundled arm,
+//! each on its own: the worst case for the timeline, every link flickering) replayed with the
+//! output bag as before (`/collisions` only), with the markers, `/tf` and `/robot_description`
+//! for viewers, and with those and `--plot`. The three run interleaved, round after round, so
+//! the ratio is taken under the same load. Prints a table, the SVG's size and element count.
+//!
+//! `cargo bench --bench replay_view` (`ROUNDS=n` to change the 3 rounds)
+
+use mcap::records::MessageHeader;
+use oorandom::Rand64;
+use std::collections::BTreeMap;
+use std::io::BufWriter;
+use std::path::Path;
+use std::time::Instant;
+use thickness_collision::checker::Checker;
+use thickness_collision::model::Params;
+use thickness_collision::msgs::{Header, JointState, Time};
+use thickness_collision::replay::encode_cdr_le;
+use thickness_collision::replay::{replay, ReplayOptions};
+
+const STATES: usize = 360_000;
+const PERIOD_NS: i64 = 10_000_000;
+
+fn write_bag(dir: &Path, checker: &Checker) {
+    std::fs::create_dir_all(dir).unwrap();
+    let file = std::fs::File::create(dir.join("hour_0.mcap")).unwrap();
+    let mut w = mcap::WriteOptions::new().profile("ros2").create(BufWriter::new(file)).unwrap();
+    let def = "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n";
+    let schema = w.add_schema("sensor_msgs/msg/JointState", "ros2msg", def.as_bytes()).unwrap();
+    let ch = w.add_channel(schema, "/joint_states", "cdr", &BTreeMap::new()).unwrap();
+    let joints: Vec<_> = checker.robot().joints.iter().filter(|j| j.is_actuated()).collect();
+    let mut rng = Rand64::new(42);
+    let t0: i64 = 1_700_000_000_000_000_000;
+    for k in 0..STATES {
+        let t = t0 + k as i64 * PERIOD_NS;
+        let position = joints
+            .iter()
+            .map(|j| {
+                let (lo, hi) = (j.limits[0].max(-3.0), j.limits[1].min(3.0));
+                lo + (hi - lo) * rng.rand_float()
+            })
+            .collect();
+        let msg = JointState {
+            header: Header { stamp: Time::from_nanos(t), frame_id: String::new() },
+            name: joints.iter().map(|j| j.name.clone()).collect(),
+            position,
+            velocity: vec![],
+            effort: vec![],
+        };
+        w.write_to_known_channel(&MessageHeader { channel_id: ch, sequence: k as u32, log_time: t as u64, publish_time: t as u64 }, &encode_cdr_le(&msg))
+            .unwrap();
+    }
+    let _ = w.finish().unwrap();
+    std::fs::write(
+        dir.join("metadata.yaml"),
+        format!(
+            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths:\n    - hour_0.mcap\n  message_count: {STATES}\n"
+        ),
+    )
+    .unwrap();
+}
+
+fn dir_size(d: &Path) -> u64 {
+    std::fs::read_dir(d).map(|r| r.filter_map(|e| e.ok()?.metadata().ok()).map(|m| m.len()).sum()).unwrap_or(0)
+}
+
+/// CPU seconds of this process so far, every thread (the bag writer's too).
+fn cpu_seconds() -> f64 {
+    // SAFETY: getrusage writes one rusage into the zeroed struct it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    let _ = unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    s(u.ru_utime) + s(u.ru_stime)
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let rounds: usize = std::env::var("ROUNDS").ok().and_then(|v| v.parse().ok()).unwrap_or(3);
+    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let root = std::env::temp_dir().join(format!("tc_bench_replay_view_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let bag = root.join("hour");
+    write_bag(&bag, &checker);
+    println!("one hour at 100 Hz: {STATES} random joint states of the bundled arm ({:.1} MB MCAP), each checked on its own", dir_size(&bag) as f64 / 1e6);
+
+    let configs =
+        [("output bag, /collisions only (as before)", false, false), ("+ markers, /tf, /robot_description", true, false), ("+ markers and --plot", true, true)];
+    let mut seconds = vec![Vec::new(); configs.len()];
+    let mut cpu = vec![Vec::new(); configs.len()];
+    let mut sizes = vec![0u64; configs.len()];
+    let (mut svg_bytes, mut svg_elements, mut in_collision) = (0, 0, 0);
+    for round in 0..rounds {
+        for (c, (label, markers, plot)) in configs.iter().enumerate() {
+            let out = root.join("out");
+            let svg = root.join("timeline.svg");
+            let _ = std::fs::remove_dir_all(&out);
+            let opts = ReplayOptions {
+                bag: bag.clone(),
+                out_dir: Some(out.clone()),
+                plot: plot.then(|| svg.clone()),
+                no_markers: !markers,
+                motion: Some(false),
+                ..Default::default()
+            };
+            let (started, cpu0) = (Instant::now(), cpu_seconds());
+            let summary = replay(Params::default(), None, None, &opts).unwrap();
+            let secs = started.elapsed().as_secs_f64();
+            cpu[c].push(cpu_seconds() - cpu0);
+            assert_eq!(summary.states, STATES);
+            in_collision = summary.in_collision;
+            seconds[c].push(secs);
+            sizes[c] = dir_size(&out);
+            if *plot {
+                let text = std::fs::read_to_string(&svg).unwrap();
+                let _ = std::fs::copy(&svg, std::env::temp_dir().join("tc_bench_replay_view_timeline.svg"));
+                svg_bytes = text.len();
+                svg_elements =
+                    text.matches("<rect").count() + text.matches("<line").count() + text.matches("<text").count() + text.matches("<polyline").count();
+            }
+            eprintln!("round {round}: {label}: {secs:.2} s, {:.2} s CPU", cpu[c][round]);
+        }
+    }
+    println!("({in_collision} of {STATES} states in collision; {rounds} rounds, interleaved)");
+    println!("{:<42} {:>9} {:>9} {:>10} {:>10} {:>11} {:>10}", "outputs", "median s", "states/s", "rate ratio", "CPU s", "CPU ratio", "output MB");
+    let (base, base_cpu) = (median(&mut seconds[0].clone()), median(&mut cpu[0].clone()));
+    for (c, (label, ..)) in configs.iter().enumerate() {
+        let (m, mc) = (median(&mut seconds[c].clone()), median(&mut cpu[c].clone()));
+        println!("{label:<42} {m:>9.2} {:>9.0} {:>10.3} {mc:>10.2} {:>11.3} {:>10.1}", STATES as f64 / m, base / m, mc / base_cpu, sizes[c] as f64 / 1e6);
+    }
+    let per_round: Vec<String> = (0..rounds).map(|r| format!("{:.3}", seconds[0][r] / seconds[2][r])).collect();
+    println!("rate with markers and --plot / rate before, per round: {}", per_round.join(", "));
+    println!("load average at the end: {}", std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim());
+    println!("timeline SVG: {:.1} kB, {svg_elements} elements (rect, line, text)", svg_bytes as f64 / 1e3);
+    let _ = std::fs::remove_dir_all(&root);
+}

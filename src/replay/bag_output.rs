@@ -1,0 +1,258 @@
+//! Replay's output bag: `/collisions`, and what a viewer needs to draw the recording beside it
+//! (markers, the robot, its poses). Messages are built and written on a thread of their own: the
+//! replay loop only hands over each report and the link poses, so writing some 2 kB per state
+//! costs the loop little while a second core is free.
+
+use super::bag_reader::BagMessage;
+use super::bag_writer::{BagWriter, TopicId};
+use crate::checker::Checker;
+use crate::markers::{cell_markers, contact_markers};
+use crate::model::PoseSource;
+use crate::msgs::{DurationMsg, MarkerArray, StringMsg, TfMessage, Time, Transform, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};
+use crate::pipeline::{CheckedState, Pipeline, RobotState};
+use anyhow::{anyhow, Context, Result};
+use std::path::Path;
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+
+/// The topic a `robot_description` is recorded on.
+pub(super) const DESCRIPTION_TOPIC: &str = "/robot_description";
+
+/// Jobs handed over at once: one wake-up of the writer per batch, not per report (a send per
+/// report cost the loop 4 % in futex wake-ups).
+const BATCH: usize = 256;
+/// Batches queued before the loop waits for the writer: enough to ride out a slow write, few
+/// enough that memory stays small (a job is a report and a dozen poses).
+const QUEUE: usize = 16;
+
+/// What the writer thread is asked to write.
+enum Job {
+    /// An input message copied as it is.
+    Raw {
+        topic: Copied,
+        data: Vec<u8>,
+        log_time: i64,
+    },
+    Cells(MarkerArray, i64),
+    Description(StringMsg, i64),
+    /// The frame names of the `/tf` to come (after the robot changed), with the first poses.
+    Frames(TfMessage),
+    /// A report, and the link poses it was checked at (joint-state input with the view on).
+    Report {
+        checked: CheckedState,
+        poses: Option<Vec<Transform>>,
+        log_time: i64,
+    },
+}
+
+#[derive(Clone, Copy)]
+enum Copied {
+    Tf,
+    TfStatic,
+    Description,
+}
+
+/// The loop's side of the output bag.
+pub(super) struct OutputBag {
+    jobs: Option<SyncSender<Vec<Job>>>,
+    batch: Vec<Job>,
+    writer: Option<JoinHandle<Result<()>>>,
+    view: Option<ViewState>,
+}
+
+/// What the loop keeps to feed the viewer topics.
+struct ViewState {
+    /// The input is `/tf`: it is copied (with `/tf_static`). For joint states the poses the check
+    /// computed are written instead, and a `/tf` recorded beside them is not copied: the same
+    /// link frames would get a second parent.
+    copy_tf: bool,
+    /// The input has a `/robot_description`: it is copied, and the robot's file is not written.
+    copy_description: bool,
+    /// The cells (and the robot's file) are written with the first message.
+    started: bool,
+    /// The last `/tf` made, and the checker it was made for (its frame names are reused).
+    poses: TfMessage,
+    poses_of: Option<Arc<Checker>>,
+}
+
+/// The writer thread's state.
+struct Writer {
+    bag: BagWriter,
+    world: String,
+    collisions: TopicId,
+    topics: Option<ViewTopics>,
+    /// The `/tf` message written per report: names set by `Job::Frames`, poses by each report.
+    poses: TfMessage,
+}
+
+struct ViewTopics {
+    contacts: TopicId,
+    cells: TopicId,
+    description: TopicId,
+    tf: TopicId,
+    tf_static: TopicId,
+}
+
+impl OutputBag {
+    /// Creates the bag in `dir` (which must not exist) and starts its writer. `view`: the
+    /// markers, `/tf` and `/robot_description` beside `/collisions`.
+    pub(super) fn create(dir: &Path, input_topics: &[(String, String)], pose_source: PoseSource, world: &str, view: bool) -> Result<OutputBag> {
+        let mut bag = BagWriter::create(dir)?;
+        let collisions = bag.add_topic("/collisions", COLLISION_REPORT_TYPE, false)?;
+        let topics = if view {
+            Some(ViewTopics {
+                contacts: bag.add_topic("/collision_markers/contacts", MARKER_ARRAY_TYPE, false)?,
+                cells: bag.add_topic("/collision_markers/cells", MARKER_ARRAY_TYPE, true)?,
+                description: bag.add_topic(DESCRIPTION_TOPIC, STRING_TYPE, true)?,
+                tf: bag.add_topic("/tf", TF_MESSAGE_TYPE, false)?,
+                tf_static: bag.add_topic("/tf_static", TF_MESSAGE_TYPE, true)?,
+            })
+        } else {
+            None
+        };
+        let has = |topic: &str, ty: &str| input_topics.iter().any(|(t, y)| t == topic && (y.is_empty() || y == ty));
+        let state = view.then(|| ViewState {
+            copy_tf: pose_source == PoseSource::Tf,
+            copy_description: has(DESCRIPTION_TOPIC, STRING_TYPE),
+            started: false,
+            poses: TfMessage::default(),
+            poses_of: None,
+        });
+        let (jobs, queue) = sync_channel(QUEUE);
+        let writer = Writer { bag, world: world.to_owned(), collisions, topics, poses: TfMessage::default() };
+        let handle = std::thread::Builder::new().name("bag writer".into()).spawn(move || writer.run(queue)).context("cannot start the bag writer thread")?;
+        Ok(OutputBag { jobs: Some(jobs), batch: Vec::with_capacity(BATCH), writer: Some(handle), view: state })
+    }
+
+    fn send(&mut self, job: Job) -> Result<()> {
+        self.batch.push(job);
+        if self.batch.len() < BATCH {
+            return Ok(());
+        }
+        self.flush()
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        let batch = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH));
+        let sent = self.jobs.as_ref().map(|j| j.send(batch));
+        match sent {
+            Some(Ok(())) => Ok(()),
+            // The writer stopped on an error: finishing tells which.
+            _ => Err(self.stop().err().unwrap_or_else(|| anyhow!("the bag writer stopped"))),
+        }
+    }
+
+    /// Every input message before it is replayed: at the first, the cells (once, at the bag's
+    /// start) and the robot's URDF when the bag has none of its own; the input's `/tf`,
+    /// `/tf_static` and `/robot_description` are copied as they are.
+    pub(super) fn input(&mut self, pipeline: &Pipeline, m: &BagMessage) -> Result<()> {
+        let Some(view) = self.view.as_mut() else { return Ok(()) };
+        let mut jobs = Vec::new();
+        if !view.started {
+            view.started = true;
+            let params = pipeline.params();
+            let cells = cell_markers(pipeline.checker(), params.marker_max_cells.max(0) as usize, &params.world_frame, Time::from_nanos(m.log_time));
+            jobs.push(Job::Cells(cells, m.log_time));
+            if !view.copy_description {
+                let urdf = pipeline.robot_urdf().context("the robot's URDF for /robot_description in the output bag")?;
+                jobs.push(Job::Description(StringMsg { data: urdf }, m.log_time));
+            }
+        }
+        let topic = match m.topic.as_str() {
+            "/tf" if view.copy_tf => Some(Copied::Tf),
+            "/tf_static" if view.copy_tf => Some(Copied::TfStatic),
+            DESCRIPTION_TOPIC if view.copy_description => Some(Copied::Description),
+            _ => None,
+        };
+        if let Some(topic) = topic {
+            jobs.push(Job::Raw { topic, data: m.data.clone(), log_time: m.log_time });
+        }
+        jobs.into_iter().try_for_each(|j| self.send(j))
+    }
+
+    /// A report, and (for joint states, with the view on) the link poses it was checked at.
+    pub(super) fn report(&mut self, pipeline: &Pipeline, state: &RobotState, checked: CheckedState, log_time: i64) -> Result<()> {
+        let mut poses = None;
+        let mut frames = None;
+        if let Some(view) = self.view.as_mut().filter(|v| !v.copy_tf) {
+            if !view.poses_of.as_ref().is_some_and(|c| Arc::ptr_eq(c, pipeline.checker())) {
+                view.poses = TfMessage::default();
+                view.poses_of = Some(pipeline.checker().clone());
+            }
+            let fresh = view.poses.transforms.is_empty();
+            if pipeline.link_transforms(state, &mut view.poses) {
+                if fresh {
+                    frames = Some(view.poses.clone());
+                }
+                poses = Some(view.poses.transforms.iter().map(|t| t.transform).collect());
+            }
+        }
+        if let Some(f) = frames {
+            self.send(Job::Frames(f))?;
+        }
+        self.send(Job::Report { checked, poses, log_time })
+    }
+
+    /// Waits for the writer to write everything, finish the MCAP file and `metadata.yaml`.
+    pub(super) fn finish(mut self) -> Result<()> {
+        self.flush()?;
+        self.stop()
+    }
+
+    fn stop(&mut self) -> Result<()> {
+        drop(self.jobs.take());
+        match self.writer.take() {
+            Some(h) => h.join().map_err(|_| anyhow!("the bag writer panicked"))?,
+            None => Ok(()),
+        }
+    }
+}
+
+impl Writer {
+    fn run(mut self, queue: Receiver<Vec<Job>>) -> Result<()> {
+        for job in queue.into_iter().flatten() {
+            self.write(job)?;
+        }
+        let _ = self.bag.finish()?;
+        Ok(())
+    }
+
+    fn write(&mut self, job: Job) -> Result<()> {
+        let topics = self.topics.as_ref();
+        match (job, topics) {
+            (Job::Report { checked, poses, log_time }, _) => {
+                self.bag.write(self.collisions, &checked.message(&self.world), log_time)?;
+                let Some(t) = topics else { return Ok(()) };
+                // Lifetime zero: each report's DELETEALL replaces the one before, however far apart.
+                let markers = contact_markers(&checked.report, &self.world, checked.stamp, DurationMsg::default());
+                self.bag.write_with(t.contacts, |w| w.marker_array(&markers), log_time)?;
+                if let Some(poses) = poses {
+                    for (entry, pose) in self.poses.transforms.iter_mut().zip(poses) {
+                        entry.header.stamp = checked.stamp;
+                        entry.transform = pose;
+                    }
+                    let poses = &self.poses;
+                    self.bag.write_with(t.tf, |w| w.tf_message(poses), log_time)?;
+                }
+                Ok(())
+            }
+            (Job::Frames(tf), _) => {
+                self.poses = tf;
+                Ok(())
+            }
+            (Job::Cells(cells, log_time), Some(t)) => self.bag.write(t.cells, &cells, log_time),
+            (Job::Description(d, log_time), Some(t)) => self.bag.write(t.description, &d, log_time),
+            (Job::Raw { topic, data, log_time }, Some(t)) => {
+                let id = match topic {
+                    Copied::Tf => t.tf,
+                    Copied::TfStatic => t.tf_static,
+                    Copied::Description => t.description,
+                };
+                self.bag.write_raw(id, &data, log_time)
+            }
+            // Viewer messages are only made with the viewer topics.
+            (_, None) => Ok(()),
+        }
+    }
+}
