@@ -164,7 +164,7 @@ impl Default for Params {
             use_visual_when_no_collision: false,
             pose_source: PoseSource::JointStates,
             frame_prefix: String::new(),
-            marker_max_cells: 20_000,
+            marker_max_cells: 5_000,
             marker_rate: 10.0,
             use_sim_time: false,
             service_mapping: ServiceMapping::Cyclone,
