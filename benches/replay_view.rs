@@ -1,10 +1,13 @@
-//! Issue 16's figure: a one-hour bag at 100 Hz (360,000 random joint states of the bundled arm,
-//! each on its own: the worst case for the timeline, every link flickering) replayed with the
-//! output bag as before (`/collisions` only), with the markers, `/tf` and `/robot_description`
-//! for viewers, and with those and `--plot`. The three run interleaved, round after round, so
-//! the ratio is taken under the same load. Prints a table, the SVG's size and element count.
+//! Issue 16's figure: one-hour bags at 100 Hz (360,000 joint states of the bundled arm) replayed
+//! with the output bag as before (`/collisions` only), with the markers, `/tf` and
+//! `/robot_description` for viewers, and with those and `--plot`, interleaved round after round
+//! so the ratios are taken under the same load. Two bags: random states checked each on its own
+//! (the cheapest checks, so the view's share is largest, and every link flickers: the worst case
+//! for the timeline), and a smooth sweep replayed with the default parameters (motions checked),
+//! as an hour of robot work is. Prints a table per bag, the SVG's size and element count.
 //!
-//! `cargo bench --bench replay_view` (`ROUNDS=n` to change the 3 rounds)
+//! `cargo bench --bench replay_view` (`ROUNDS=n` to change the 3 rounds; `BAGS=random` or
+//! `BAGS=sweep` for one of the two)
 
 use mcap::records::MessageHeader;
 use oorandom::Rand64;
@@ -21,7 +24,7 @@ use thickness_collision::replay::{replay, ReplayOptions};
 const STATES: usize = 360_000;
 const PERIOD_NS: i64 = 10_000_000;
 
-fn write_bag(dir: &Path, checker: &Checker) {
+fn write_bag(dir: &Path, checker: &Checker, sweep: bool) {
     std::fs::create_dir_all(dir).unwrap();
     let file = std::fs::File::create(dir.join("hour_0.mcap")).unwrap();
     let mut w = mcap::WriteOptions::new().profile("ros2").create(BufWriter::new(file)).unwrap();
@@ -33,11 +36,19 @@ fn write_bag(dir: &Path, checker: &Checker) {
     let t0: i64 = 1_700_000_000_000_000_000;
     for k in 0..STATES {
         let t = t0 + k as i64 * PERIOD_NS;
+        let s = k as f64 / 100.0 * 1.5;
+        // The path of scripts/example_recording.sh, fingers closed.
+        let path = [1.2 * (0.9 * s).sin(), 0.7 + 0.6 * (2.1 * s).sin(), 0.3 + 0.6 * (1.3 * s + 0.5).sin(), 0.8 * (1.7 * s).sin(), 0.5 * (1.1 * s).cos(), 0.0];
         let position = joints
             .iter()
-            .map(|j| {
+            .enumerate()
+            .map(|(i, j)| {
                 let (lo, hi) = (j.limits[0].max(-3.0), j.limits[1].min(3.0));
-                lo + (hi - lo) * rng.rand_float()
+                if sweep {
+                    path.get(i).copied().unwrap_or(lo.max(0.0).min(hi))
+                } else {
+                    lo + (hi - lo) * rng.rand_float()
+                }
             })
             .collect();
         let msg = JointState {
@@ -80,15 +91,29 @@ fn median(v: &mut [f64]) -> f64 {
 
 fn main() {
     let rounds: usize = std::env::var("ROUNDS").ok().and_then(|v| v.parse().ok()).unwrap_or(3);
+    let bags = std::env::var("BAGS").unwrap_or_default();
     let checker = Checker::from_params(Params::default(), None, None).unwrap();
     let root = std::env::temp_dir().join(format!("tc_bench_replay_view_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&root);
-    let bag = root.join("hour");
-    write_bag(&bag, &checker);
-    println!("one hour at 100 Hz: {STATES} random joint states of the bundled arm ({:.1} MB MCAP), each checked on its own", dir_size(&bag) as f64 / 1e6);
+    if bags != "sweep" {
+        scenario(&root, &checker, false, rounds);
+    }
+    if bags != "random" {
+        scenario(&root, &checker, true, rounds);
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
 
+fn scenario(root: &Path, checker: &Checker, sweep: bool, rounds: usize) {
+    let bag = root.join(if sweep { "sweep" } else { "random" });
+    write_bag(&bag, checker, sweep);
+    let what = if sweep { "a smooth sweep, motions checked (the default parameters)" } else { "random joint states, each checked on its own" };
+    println!("\none hour at 100 Hz: {STATES} states of the bundled arm, {what} ({:.1} MB MCAP)", dir_size(&bag) as f64 / 1e6);
     let configs =
         [("output bag, /collisions only (as before)", false, false), ("+ markers, /tf, /robot_description", true, false), ("+ markers and --plot", true, true)];
+    // The sweep's checks take long: the middle row is left out there.
+    let configs: Vec<_> = configs.into_iter().enumerate().filter(|(i, _)| !sweep || *i != 1).map(|(_, c)| c).collect();
+    let last = configs.len() - 1;
     let mut seconds = vec![Vec::new(); configs.len()];
     let mut cpu = vec![Vec::new(); configs.len()];
     let mut sizes = vec![0u64; configs.len()];
@@ -103,7 +128,7 @@ fn main() {
                 out_dir: Some(out.clone()),
                 plot: plot.then(|| svg.clone()),
                 no_markers: !markers,
-                motion: Some(false),
+                motion: Some(sweep),
                 ..Default::default()
             };
             let (started, cpu0) = (Instant::now(), cpu_seconds());
@@ -116,7 +141,8 @@ fn main() {
             sizes[c] = dir_size(&out);
             if *plot {
                 let text = std::fs::read_to_string(&svg).unwrap();
-                let _ = std::fs::copy(&svg, std::env::temp_dir().join("tc_bench_replay_view_timeline.svg"));
+                let name = format!("tc_bench_replay_view_{}.svg", if sweep { "sweep" } else { "random" });
+                let _ = std::fs::copy(&svg, std::env::temp_dir().join(name));
                 svg_bytes = text.len();
                 svg_elements =
                     text.matches("<rect").count() + text.matches("<line").count() + text.matches("<text").count() + text.matches("<polyline").count();
@@ -131,9 +157,9 @@ fn main() {
         let (m, mc) = (median(&mut seconds[c].clone()), median(&mut cpu[c].clone()));
         println!("{label:<42} {m:>9.2} {:>9.0} {:>10.3} {mc:>10.2} {:>11.3} {:>10.1}", STATES as f64 / m, base / m, mc / base_cpu, sizes[c] as f64 / 1e6);
     }
-    let per_round: Vec<String> = (0..rounds).map(|r| format!("{:.3}", seconds[0][r] / seconds[2][r])).collect();
+    let per_round: Vec<String> = (0..rounds).map(|r| format!("{:.3}", seconds[0][r] / seconds[last][r])).collect();
     println!("rate with markers and --plot / rate before, per round: {}", per_round.join(", "));
     println!("load average at the end: {}", std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim());
     println!("timeline SVG: {:.1} kB, {svg_elements} elements (rect, line, text)", svg_bytes as f64 / 1e3);
-    let _ = std::fs::remove_dir_all(&root);
+    let _ = std::fs::remove_dir_all(&bag);
 }

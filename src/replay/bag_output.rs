@@ -1,7 +1,7 @@
 //! Replay's output bag: `/collisions`, and what a viewer needs to draw the recording beside it
 //! (markers, the robot, its poses). Messages are built and written on a thread of their own: the
-//! replay loop only hands over each report and the link poses, so writing some 2 kB per state
-//! costs the loop little while a second core is free.
+//! replay loop only hands over each report and the link poses, so the writing (some 2 kB per
+//! state) can run on a second core (docs/benchmarks.md: what it costs when none is free).
 
 use super::bag_reader::BagMessage;
 use super::bag_writer::{BagWriter, TopicId};
