@@ -345,7 +345,8 @@ fn write_outputs(out: &mut Outputs, pipeline: &Pipeline, state: &RobotState, che
     if let Some((timeline, _)) = out.plot.as_mut() {
         // A motion in collision may have met something only between the two states: the state's
         // own check tells which links collide at the state (plotted differently).
-        let own = (checked.report.motion && checked.report.in_collision)
+        let own = timeline
+            .needs_state_check(&checked.report)
             .then(|| pipeline.check(state).report.contacts.into_iter().map(|c| c.link_name).collect::<std::collections::HashSet<_>>());
         timeline.record(seconds, &checked.report, own.as_ref());
     }

@@ -20,9 +20,9 @@ pub struct TimelineBar {
     pub states: (usize, usize),
     /// Reports in which the link collides.
     pub colliding: u64,
-    /// Of those, the reports whose own state collides (the others are motion-only hits: the
-    /// link met something between two states, not at the state reported).
-    pub state_hits: u64,
+    /// Some report of the run collides at its own state. Without one the run is motion-only: the
+    /// link met something between states, never at a state reported.
+    pub state_hit: bool,
     /// Deepest contact of the link in the run (metres).
     pub depth: f64,
     /// Objects (or links, for self-collision) the link touched.
@@ -34,7 +34,7 @@ pub struct TimelineBar {
 impl TimelineBar {
     /// No state in it collides: only the motions into them do.
     pub fn motion_only(&self) -> bool {
-        self.state_hits == 0
+        !self.state_hit
     }
 
     /// Takes `next` (later) into this bar.
@@ -42,7 +42,7 @@ impl TimelineBar {
         self.end = next.end;
         self.states.1 = next.states.1;
         self.colliding += next.colliding;
-        self.state_hits += next.state_hits;
+        self.state_hit |= next.state_hit;
         self.depth = self.depth.max(next.depth);
         self.objects.extend(next.objects);
         self.runs += next.runs;
@@ -72,8 +72,6 @@ pub struct Timeline {
     pub reports: usize,
     /// Reports in collision.
     pub in_collision: usize,
-    /// Reports in collision with no link colliding at the reported state (motion-only).
-    pub motion_only: usize,
     /// Seconds from the bag's first message to the last report.
     pub last_seconds: f64,
     /// The deepest contact.
@@ -81,9 +79,28 @@ pub struct Timeline {
 }
 
 impl Timeline {
-    /// Records the next report, made `seconds` after the bag's first message. `state_links`: for
-    /// a report in collision over a motion, the links that collide at the reported state itself
-    /// (`None` when the report is the state's own check).
+    /// Whether the next report's state must be checked on its own to tell motion-only hits: a
+    /// motion in collision where some colliding link has no state hit in its run yet. A run
+    /// known to hit at a state stays so, so a long contact costs one second check, not one per
+    /// report.
+    pub fn needs_state_check(&self, report: &StateReport) -> bool {
+        let n = self.reports + 1;
+        report.motion
+            && report.in_collision
+            && report.contacts.iter().any(|c| {
+                let bar = self.rows.iter().find(|r| r.link == c.link_name).and_then(|r| r.bars.last());
+                !bar.is_some_and(|b| b.state_hit && b.states.1 + 1 >= n)
+            })
+    }
+
+    /// Motion-only runs (bars) in the picture's rows.
+    pub fn motion_only_runs(&self) -> usize {
+        self.rows.iter().flat_map(|r| &r.bars).filter(|b| b.motion_only()).count()
+    }
+
+    /// Records the next report, made `seconds` after the bag's first message. `state_links`: the
+    /// links that collide at the reported state itself, when [`Timeline::needs_state_check`] asked
+    /// for them (`None`: every colliding link counts as a state hit).
     pub fn record(&mut self, seconds: f64, report: &StateReport, state_links: Option<&HashSet<String>>) {
         self.reports += 1;
         self.last_seconds = seconds;
@@ -93,10 +110,8 @@ impl Timeline {
         }
         self.in_collision += 1;
         // A failed check has no contacts: it counts, but draws no bar.
-        let mut any_state_hit = report.contacts.is_empty();
         for c in &report.contacts {
             let state_hit = state_links.is_none_or(|s| s.contains(&c.link_name));
-            any_state_hit |= state_hit;
             if self.deepest.as_ref().is_none_or(|d| c.depth > d.4) {
                 self.deepest = Some((seconds, n, c.link_name.clone(), c.object_name.clone(), c.depth));
             }
@@ -117,7 +132,7 @@ impl Timeline {
                     b.end = seconds;
                     b.states.1 = n;
                     b.colliding += 1;
-                    b.state_hits += state_hit as u64;
+                    b.state_hit |= state_hit;
                     b.depth = b.depth.max(c.depth);
                 }
                 _ => row.bars.push(TimelineBar {
@@ -125,7 +140,7 @@ impl Timeline {
                     end: seconds,
                     states: (n, n),
                     colliding: 1,
-                    state_hits: state_hit as u64,
+                    state_hit,
                     depth: c.depth,
                     objects: BTreeSet::new(),
                     runs: 1,
@@ -140,9 +155,6 @@ impl Timeline {
             if row.bars.len() > MAX_BARS_KEPT {
                 row.coarsen();
             }
-        }
-        if !any_state_hit {
-            self.motion_only += 1;
         }
     }
 }
@@ -210,8 +222,20 @@ mod tests {
         assert_eq!(a, [((2, 3), 2, 0.03), ((5, 6), 2, 0.02)]);
         assert_eq!(t.rows[1].link, "b");
         assert!(t.rows[1].bars[0].motion_only(), "b collided only along the motion into report 3");
-        assert_eq!((t.reports, t.in_collision, t.motion_only), (6, 4, 0));
+        assert_eq!((t.reports, t.in_collision, t.motion_only_runs()), (6, 4, 1));
         assert_eq!(t.deepest.as_ref().map(|d| (d.1, d.4)), Some((3, 0.03)));
+    }
+
+    #[test]
+    fn a_state_is_checked_again_only_while_its_run_has_no_state_hit() {
+        let mut t = Timeline::default();
+        let motion = |links: &[(&str, f64)]| StateReport { motion: true, ..hit(links) };
+        t.record(0.0, &hit(&[("a", 0.01)]), None);
+        assert!(!t.needs_state_check(&motion(&[("a", 0.01)])), "a's run already hit at a state");
+        assert!(t.needs_state_check(&motion(&[("a", 0.01), ("b", 0.0)])), "b starts a run");
+        assert!(!t.needs_state_check(&hit(&[("b", 0.01)])), "a state's own check needs no other");
+        t.record(0.01, &hit(&[]), None);
+        assert!(t.needs_state_check(&motion(&[("a", 0.01)])), "a's next run starts after a free report");
     }
 
     #[test]

@@ -51,8 +51,13 @@ fn draw(root: &DrawingArea<SVGBackend, Shift>, t: &Timeline, bag: &str) -> Resul
         Some((s, n, link, object, d)) => format!("deepest contact: {link} x {object}, {:.1} mm at {s:.3} s (state {n})", d * 1e3),
         None => "deepest contact: none".into(),
     };
-    let counts =
-        format!("{} states, {} in collision ({} motion-only), {} links in collision; {deepest}", t.reports, t.in_collision, t.motion_only, t.rows.len());
+    let counts = format!(
+        "{} states, {} in collision, {} motion-only runs, {} links in collision; {deepest}",
+        t.reports,
+        t.in_collision,
+        t.motion_only_runs(),
+        t.rows.len()
+    );
     header.draw(&Text::new(counts, (10, 34), text(17)))?;
     // The legend: swatches drawn like the bars they stand for.
     let mut x = 10;
