@@ -107,7 +107,10 @@ pub const DATAGRAM_HEADER_OVERHEAD: usize = 48;
 // Readers (v2.5 Section 8.4.14.1.1), so this is a constant and must NOT be
 // varied per peer. Per-peer path MTU only controls how many fragments we pack
 // into each DATAFRAG submessage / datagram, never the fragment size itself.
-pub const FRAGMENT_SIZE: usize = 256;
+// thickness_collision patch: 1024, not 256. One NACKFRAG asks for at most 256 fragments, so the
+// fragment size bounds what one repair round trip recovers (64 KiB -> 256 KiB); 1024 bytes and a
+// DATAFRAG header still fit one datagram of a 1500-byte MTU (vendor/rustdds/PATCHES.md, change 8).
+pub const FRAGMENT_SIZE: usize = 1024;
 
 /// Convert an interface MTU into the RTPS-message (UDP payload) budget usable
 /// for submessage/fragment packing: `mtu - DATAGRAM_HEADER_OVERHEAD`, floored
