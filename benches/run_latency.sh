@@ -53,14 +53,14 @@ out=$(mktemp -d)
 pids=()
 trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done' EXIT
 
-start() {  # start WHO DOMAIN
+start() {  # start WHO DOMAIN: the answerer in the background, its pid in $pid
     case $1 in
         node) ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/thickness_collision run --params-file config/params.yaml > "$out/node-$2.log" 2>&1 & ;;
         rust) ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/examples/ros_relay relay > "$out/rust-$2.log" 2>&1 & ;;
         cpp) "${pin_answer[@]}" "$peer" relay "$2" > "$out/cpp-$2.log" 2>&1 & ;;
     esac
-    pids+=($!)
-    echo $!
+    pid=$!
+    pids+=("$pid")
 }
 
 load_before=$(cut -d' ' -f1-3 /proc/loadavg)
@@ -68,7 +68,7 @@ for round in $(seq 1 "$rounds"); do
     for who in $only; do
         d=$domain
         domain=$(( domain + 1 ))
-        pid=$(start "$who" "$d")
+        start "$who" "$d"
         # One measuring participant for both rates (one that left without a word would keep a
         # RustDDS reliable writer waiting on it until its lease ends).
         "${pin_send[@]}" "$peer" measure "$d" "$seconds" 1 1000 10000 > "$out/$who-$round.jsonl"
