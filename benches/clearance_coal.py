@@ -15,19 +15,14 @@ import coal
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "peers"))
-from hull_parts import coal_convex, read_part  # noqa: E402
+from hull_parts import coal_bvh, coal_convex, read_env, read_part  # noqa: E402
 
 d = Path(sys.argv[1])
 meta = json.loads((d / "meta.json").read_text())
-V = np.fromfile(d / "env_vertices.f64", dtype="<f8").reshape(-1, 3)
-T = np.fromfile(d / "env_triangles.u32", dtype="<u4").reshape(-1, 3).astype(np.int64)
+V, T = read_env(d)
 S, P = meta["states"], meta["parts"]
 poses = np.fromfile(d / "poses.f64", dtype="<f8").reshape(S, P, 12)
-env = coal.BVHModelOBBRSS()
-env.beginModel(len(T), len(V))
-env.addVertices(V)
-env.addTriangles(T)
-env.endModel()
+env = coal_bvh(V, T)
 shapes = []
 for i in range(P):
     pv, pt = read_part(d, i)

@@ -16,12 +16,11 @@ import fcl
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "peers"))
-from hull_parts import coal_convex, read_part  # noqa: E402
+from hull_parts import coal_bvh, coal_convex, read_env, read_part  # noqa: E402
 
 d = Path(sys.argv[1])
 meta = json.loads((d / "meta.json").read_text())
-V = np.fromfile(d / "env_vertices.f64", dtype="<f8").reshape(-1, 3)
-T = np.fromfile(d / "env_triangles.u32", dtype="<u4").reshape(-1, 3).astype(np.int64)
+V, T = read_env(d)
 poses = np.fromfile(d / "poses.f64", dtype="<f8").reshape(meta["states"], meta["parts"], 12)
 parts = []
 for i in range(meta["parts"]):
@@ -31,11 +30,7 @@ S, P = meta["states"], meta["parts"]
 out = {}
 
 # ---- coal
-env = coal.BVHModelOBBRSS()
-env.beginModel(len(T), len(V))
-env.addVertices(V)
-env.addTriangles(T)
-env.endModel()
+env = coal_bvh(V, T)
 shapes = []
 for pv, pt in parts:
     shapes.append(coal_convex(pv, pt))

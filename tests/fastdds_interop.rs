@@ -372,11 +372,8 @@ fn fastdds_latched_robot_description_is_taken_by_a_node_started_after_it() {
 /// Python (`tests/peers/param_peer.py`), Cyclone's request/reply mapping.
 #[test]
 fn parameter_services_follow_service_mapping_cyclone() {
-    use std::io::Write;
-    use std::process::Stdio;
     let dir = scratch("params_cyclone");
-    let cyclone = dir.join("cyclone.xml");
-    std::fs::write(&cyclone, common::CYCLONE_LOOPBACK).unwrap();
+    let cyclone = common::cyclone_loopback_file(&dir);
     let domain = 163;
     let (node, out, _banner) = start_node(&["--ros-args", "-r", "__node:=tc_cy", "-p", "service_mapping:=cyclone"], domain);
     let calls = json!([
@@ -392,19 +389,7 @@ fn parameter_services_follow_service_mapping_cyclone() {
         {"service": "set_parameters_atomically", "request": {"parameters": [{"name": "default_thickness", "double": 0.06}, {"name": "world_frame", "double": 1.0}]}},
         {"service": "get_parameters", "request": {"names": ["default_thickness", "marker_rate"]}},
     ]);
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/param_peer.py");
-    let mut child = Command::new(common::python())
-        .arg(&script)
-        .env("CYCLONEDDS_URI", format!("file://{}", cyclone.display()))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child.stdin.take().unwrap().write_all(json!({"domain": domain, "node": "tc_cy", "calls": calls, "timeout": 20}).to_string().as_bytes()).unwrap();
-    let o = child.wait_with_output().unwrap();
-    assert!(o.status.success(), "param_peer.py: {}", String::from_utf8_lossy(&o.stderr));
-    let a: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let a = common::run_cyclone_peer("param_peer.py", &cyclone, &json!({"domain": domain, "node": "tc_cy", "calls": calls, "timeout": 20}).to_string());
     let answers = a["answers"].as_array().unwrap();
     assert!(answers.iter().all(Value::is_object), "every call answered over the Cyclone mapping: {a}");
     assert_eq!(answers[0]["values"], json!([[3, 0.02, ""], [4, 0.0, "world"], [0, 0.0, ""]]), "{a}");

@@ -21,3 +21,20 @@ def coal_convex(pv, pt):
     for v in pv:
         verts.append(np.asarray(v, dtype=float))
     return coal.Convex(verts, tris)
+
+
+def read_env(d):
+    """(vertices n×3 float64, triangles m×3 int64) of the world mesh the Rust side exported."""
+    V = np.fromfile(d / "env_vertices.f64", dtype="<f8").reshape(-1, 3)
+    T = np.fromfile(d / "env_triangles.u32", dtype="<u4").reshape(-1, 3).astype(np.int64)
+    return V, T
+
+
+def coal_bvh(V, T):
+    """The world as coal's OBBRSS BVH model of its bare triangles (no thickness)."""
+    env = coal.BVHModelOBBRSS()
+    env.beginModel(len(T), len(V))
+    env.addVertices(V)
+    env.addTriangles(T)
+    env.endModel()
+    return env
