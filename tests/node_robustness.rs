@@ -13,8 +13,11 @@
 //! the test allowed; the patched RustDDS in `vendor/rustdds` (`vendor/rustdds/PATCHES.md`: no
 //! second buffer for a repeated fragment of a completed sample, no copy of a reassembled sample,
 //! announced sizes over 64 MiB refused before any allocation) keeps the node within the issue's
-//! bound (peaks of 87-96 MiB against about 116 allowed, 5 runs; a large sample's bytes leave
-//! RustDDS's topic cache once the node has taken it), so the allowance is gone.
+//! bound, so the allowance is gone. What was left of the joint-state phase used to stack under
+//! the 50 MB description (peaks of 89-120 MiB against about 117 allowed: one CI run in four
+//! failed): ~10 MB joint states whose fragments were lost in the burst kept their assembly
+//! buffers (patch 9 drops them at once), and glibc kept freed blocks after its thresholds rose
+//! (the node fixes them: `src/ros/memory_return.rs`). Now 67-71 MiB in 4 runs.
 //!
 //! Network: node and peer run in a private network namespace with only `lo` (`unshare -n`, the
 //! peer joining it with `nsenter`) where that is allowed, else on loopback with the loopback

@@ -9,6 +9,7 @@
 
 mod diagnostics;
 mod discovery_range;
+mod memory_return;
 mod msg_impls;
 mod node_run;
 mod param_services;

@@ -7,6 +7,7 @@
 
 use super::diagnostics::{diagnostics, NodeStats};
 use super::discovery_range::DiscoverySettings;
+use super::memory_return::MemoryReturn;
 use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
 use super::param_services::{ros_mapping, ParamRequest, ParamRequests, ParamServers};
 use super::param_values::{declarations, to_json, READ_ONLY};
@@ -378,6 +379,7 @@ struct NodeState {
     description_error: Option<String>,
     /// The shutdown line as of the last turn, for a stop that cannot wait for the loop.
     summary: Arc<Mutex<String>>,
+    memory: MemoryReturn,
 }
 
 impl NodeState {
@@ -684,6 +686,7 @@ impl NodeState {
             if io.diagnostics.publish(status).is_err() {
                 self.log.warn("diagnostics", || "publishing /diagnostics failed".into());
             }
+            let _ = self.memory.tick();
         }
         self.refresh_summary();
     }
@@ -779,6 +782,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         fqn,
         description_error: None,
         summary,
+        memory: MemoryReturn::new(),
     };
 
     smol::block_on(async {

@@ -333,6 +333,14 @@ impl FragmentAssembler {
   // AssemblyBuffers   self.assembly_buffers.keys()
   // }
 
+  // thickness_collision patch: drops the buffers of sequence numbers that can no longer be
+  // delivered (PATCHES.md, change 9); returns how many were dropped.
+  pub fn drop_buffers_where(&mut self, mut dead: impl FnMut(SequenceNumber) -> bool) -> usize {
+    let before = self.assembly_buffers.len();
+    self.assembly_buffers.retain(|sn, _| !dead(*sn));
+    before - self.assembly_buffers.len()
+  }
+
   pub fn is_partially_received(&self, sn: SequenceNumber) -> bool {
     self.assembly_buffers.contains_key(&sn)
     // assembly buffers map contains a key (SN) if and only if we have some

@@ -742,6 +742,30 @@ impl Reader {
     }
   }
 
+  // thickness_collision patch: the assembly buffers of `writer_guid` that can never complete are
+  // dropped as soon as that is known, not 10 s later by `garbage_collect_fragments` (which runs
+  // only when another incomplete DATAFRAG arrives): sequence numbers the writer proxy has as
+  // received or irrelevant (after a GAP, or a HEARTBEAT whose first_sn moved past them), and in a
+  // BestEffort Reader every sequence number below one just delivered (no fragment is ever
+  // repaired for it; the writer sends in order). PATCHES.md, change 9.
+  fn drop_dead_assemblies(&mut self, writer_guid: GUID, delivered: Option<SequenceNumber>) {
+    let best_effort = self.reliability == policy::Reliability::BestEffort;
+    let Some(fa) = self.fragment_assemblers.get_mut(&writer_guid) else {
+      return;
+    };
+    let proxy = self.matched_writers.get(&writer_guid);
+    let dropped = fa.drop_buffers_where(|sn| {
+      proxy.is_some_and(|wp| wp.should_ignore_change(sn))
+        || (best_effort && delivered.is_some_and(|d| sn < d))
+    });
+    if dropped > 0 {
+      debug!(
+        "dropped {dropped} assembly buffer(s) of {writer_guid:?} that cannot complete, topic={:?}",
+        self.topic_name
+      );
+    }
+  }
+
   fn missing_frags_for(
     &self,
     writer_guid: GUID,
@@ -825,6 +849,8 @@ impl Reader {
     self.seqnum_instant_map.insert(writer_sn, receive_timestamp);
 
     self.notify_cache_change();
+    // thickness_collision patch (change 9)
+    self.drop_dead_assemblies(writer_guid, Some(writer_sn));
   }
 
   fn data_to_dds_data(
@@ -979,6 +1005,11 @@ impl Reader {
 
         // remove changes until first_sn.
         writer_proxy.irrelevant_changes_up_to(heartbeat.first_sn);
+        // thickness_collision patch (change 9): the writer no longer has these, so their
+        // partial samples cannot complete (the proxy is out of `matched_writers` here).
+        if let Some(fa) = this.fragment_assemblers.get_mut(&writer_guid) {
+          let _ = fa.drop_buffers_where(|sn| writer_proxy.should_ignore_change(sn));
+        }
 
         let marker_moved = this
           .acquire_the_topic_cache_guard()
@@ -1203,6 +1234,8 @@ impl Reader {
     }
     // able to move forward, i.e. hand over data to application, if
     // we now know that nothing is missng from the past.
+    // thickness_collision patch (change 9)
+    self.drop_dead_assemblies(writer_guid, None);
 
     // TODO: If receiving GAP actually moved the reliably received mark forward
     // in the Topic Cache, then we should generate a SAMPLE_LOST status event
