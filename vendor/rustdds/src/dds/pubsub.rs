@@ -546,12 +546,17 @@ impl InnerPublisher {
         .unwrap_or(policy::Durability::Volatile),
       policy::Durability::Volatile
     );
+    // thickness_collision patch (PATCHES.md, change 10): a KEEP_LAST writer keeps its newest
+    // `max_retain` samples and does not wait on the reliable window. Only an explicit KEEP_LAST:
+    // without a History policy the writer behaves as published.
+    let keep_last = matches!(writer_qos.history(), Some(policy::History::KeepLast { .. }));
     let send_buffer = WriterSendBuffer::new(
       guid,
       topic.name(),
       writer_qos.is_reliable(),
       guid.entity_id.entity_kind.is_built_in(),
       volatile,
+      keep_last,
       window_limit,
       backlog_limit,
       max_retain,

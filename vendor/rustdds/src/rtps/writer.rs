@@ -2779,15 +2779,21 @@ mod tests {
         reader_locator: Option<SocketAddr>,
       ) -> Self {
         let guid = GUID::new(GuidPrefix::new(&[1; 12]), writer_id);
+        // thickness_collision patch (change 10): a KEEP_LAST writer keeps `depth` samples.
+        let depth = match writer_qos.history() {
+          Some(History::KeepLast { depth }) => Some(depth as usize),
+          _ => None,
+        };
         let send_buffer = WriterSendBuffer::new(
           guid,
           "repair_test".to_string(),
           true, // reliable
           writer_id.kind().is_built_in(),
           false,
+          depth.is_some(),
           DEFAULT_WRITER_MAX_SAMPLES,
           DEFAULT_WRITER_MAX_SAMPLES,
-          DEFAULT_WRITER_MAX_SAMPLES,
+          depth.unwrap_or(DEFAULT_WRITER_MAX_SAMPLES),
         );
         for _ in 0..sample_count {
           let data = DDSData::new(SerializedPayload::new(
@@ -2852,11 +2858,20 @@ mod tests {
       }
 
       fn user(sample_count: i64, payload_len: usize, reader_locator: Option<SocketAddr>) -> Self {
+        Self::user_with_history(sample_count, payload_len, reader_locator, History::KeepAll)
+      }
+
+      fn user_with_history(
+        sample_count: i64,
+        payload_len: usize,
+        reader_locator: Option<SocketAddr>,
+        history: History,
+      ) -> Self {
         let qos = QosPolicyBuilder::new()
           .reliability(Reliability::Reliable {
             max_blocking_time: Duration::from_millis(100),
           })
-          .history(History::KeepAll)
+          .history(history)
           .durability(Durability::TransientLocal)
           .build();
         Self::new(
@@ -3014,6 +3029,24 @@ mod tests {
         .reader_events(StdDuration::from_millis(50))
         .iter()
         .all(|event| !matches!(event, TimedEvent::SendRepairFrags { .. })));
+    }
+
+    // thickness_collision patch (change 10): a KEEP_LAST writer dropped the
+    // samples before its newest `depth` although the reader acknowledged none;
+    // the reader's request for them is answered by one GAP and the samples
+    // still held, in one round, and the reader is not asked to wait for more.
+    #[test]
+    fn keep_last_answers_dropped_samples_with_gap() {
+      let mut f = Fixture::user_with_history(20, 8, None, History::KeepLast { depth: 5 });
+      assert_eq!(
+        f.writer.send_buffer.first_change_sequence_number(),
+        SequenceNumber::new(16)
+      );
+      f.writer.nack_response_delay = StdDuration::ZERO;
+      f.ack_nack(1..=20, 1);
+      assert_eq!(f.unsent(), 20);
+      assert_eq!(f.repair_round(), 20);
+      assert!(!f.reader_proxy().repair_mode);
     }
 
     // A repeated ACKNACK count is a copy and changes nothing; a new count does.

@@ -89,6 +89,10 @@ struct Shared {
   // (TRANSIENT_LOCAL / TRANSIENT / PERSISTENT) the writer must retain samples for
   // late-joining readers, so pre-match trimming is disabled.
   volatile: bool,
+  // thickness_collision patch (PATCHES.md, change 10): History is KEEP_LAST. Such a writer never
+  // waits for acknowledgements: it keeps the newest `max_retain` (the depth) samples, drops the
+  // oldest even if a reader has not acknowledged them, and that reader gets a GAP for them.
+  keep_last: bool,
   topic_name: String,
 }
 
@@ -114,6 +118,7 @@ impl WriterSendBuffer {
     reliable_writer: bool,
     is_builtin: bool,
     volatile: bool,
+    keep_last: bool, // thickness_collision patch (change 10)
     window_limit: usize,
     backlog_limit: usize,
     max_retain: usize,
@@ -137,6 +142,7 @@ impl WriterSendBuffer {
         reliable_writer,
         is_builtin,
         volatile,
+        keep_last,
         topic_name,
       }),
     }
@@ -171,7 +177,11 @@ impl WriterSendBuffer {
       return false;
     }
 
-    if !shared.reliable_writer || !inner.reliable_readers_present {
+    // thickness_collision patch (change 10): nor have KEEP_LAST writers. Waiting here let one
+    // reader that stopped acknowledging (a stopped or hung process, still matched until its
+    // lease ends) stop the writer for every other reader after `window_limit` samples, where DDS
+    // drops the oldest samples of a KEEP_LAST history instead (`insert_locked` trims them).
+    if !shared.reliable_writer || !inner.reliable_readers_present || shared.keep_last {
       // Best-effort and "no reliable reader yet" writers have no acknowledgement
       // window to wait on; the backlog limit above is their only throttle.
       return true;
@@ -288,9 +298,14 @@ impl WriterSendBuffer {
     //    durability); once a reliable reader matches, `reliable_readers_present`
     //    flips true and we retain everything again for repair.
     // Built-in (discovery) writers are always exempt to never lose discovery data.
+    // thickness_collision patch (change 10): and a reliable KEEP_LAST writer always, since it
+    // does not wait for acknowledgements (`has_room`). The repair path answers a request for a
+    // trimmed sequence number with a GAP (below `first_seq`), and heartbeats announce
+    // `first_seq`, so the reader that missed them moves on.
     let trim_keep_last = !shared.is_builtin
       && (!may_block
-        || (shared.reliable_writer && shared.volatile && !inner.reliable_readers_present));
+        || (shared.reliable_writer && shared.volatile && !inner.reliable_readers_present)
+        || (shared.reliable_writer && shared.keep_last));
     if trim_keep_last {
       while inner.changes.len() > inner.max_retain {
         // BTreeMap keeps keys sorted, so the first entry is the oldest SN.
@@ -482,6 +497,7 @@ mod tests {
       /* reliable_writer */ true,
       /* is_builtin */ false,
       /* volatile */ true,
+      /* keep_last */ false,
       /* window_limit */ 1,
       /* backlog_limit */ 1000,
       /* max_retain */ 1,
@@ -508,6 +524,7 @@ mod tests {
       /* reliable_writer */ false,
       /* is_builtin */ false,
       /* volatile */ true,
+      /* keep_last */ false,
       /* window_limit */ 1000,
       /* backlog_limit */ 2,
       /* max_retain */ 1000,
@@ -536,6 +553,7 @@ mod tests {
       /* reliable_writer */ false,
       /* is_builtin */ false,
       /* volatile */ true,
+      /* keep_last */ false,
       /* window_limit */ 1000,
       /* backlog_limit */ 1,
       /* max_retain */ 1000,
@@ -556,6 +574,7 @@ mod tests {
       false,
       /* is_builtin */ true,
       /* volatile */ true,
+      /* keep_last */ false,
       1000,
       /* backlog_limit */ 1,
       /* max_retain */ 1000,
@@ -580,6 +599,7 @@ mod tests {
       /* reliable_writer */ false,
       /* is_builtin */ false,
       /* volatile */ true,
+      /* keep_last */ false,
       /* window_limit */ 1000,
       /* backlog_limit */ 1000,
       max_retain,
@@ -603,6 +623,37 @@ mod tests {
     assert!(buf.get_by_sn(SequenceNumber::new(1)).is_none());
   }
 
+  // thickness_collision patch (change 10): a reliable KEEP_LAST writer whose
+  // matched reader acknowledges nothing is never held at the window: it keeps
+  // admitting, retains its newest `depth` samples and drops older ones, also
+  // when durable (a late joiner gets the newest `depth`, as KEEP_LAST says).
+  #[test]
+  fn keep_last_reliable_writer_never_waits_for_a_silent_reader() {
+    for volatile in [true, false] {
+      let depth = 4;
+      let buf = WriterSendBuffer::new(
+        GUID::GUID_UNKNOWN,
+        "t".to_string(),
+        /* reliable_writer */ true,
+        /* is_builtin */ false,
+        volatile,
+        /* keep_last */ true,
+        /* window_limit */ 8,
+        /* backlog_limit */ 1000,
+        /* max_retain */ depth,
+      );
+      // Matched, and never acknowledges anything.
+      buf.set_acked_frontier(Some(SequenceNumber::new(1)));
+      for _ in 0..100 {
+        assert!(admit_now(&buf, WriteOptions::default()));
+        assert!(buf.retained_len() <= depth);
+      }
+      assert_eq!(buf.last_change_sequence_number(), SequenceNumber::new(100));
+      assert_eq!(buf.first_change_sequence_number(), SequenceNumber::new(97));
+      assert!(buf.get_by_sn(SequenceNumber::new(96)).is_none());
+    }
+  }
+
   // A durable (non-VOLATILE) reliable writer must NOT drop on insert even before
   // a reader matches: it retains samples for late-joining readers. The
   // `max_retain` bound does not apply to it.
@@ -615,6 +666,7 @@ mod tests {
       /* reliable_writer */ true,
       /* is_builtin */ false,
       /* volatile */ false, // TRANSIENT_LOCAL etc: keep for late joiners
+      /* keep_last */ false,
       /* window_limit */ 1000,
       /* backlog_limit */ 1000,
       max_retain,
@@ -643,6 +695,7 @@ mod tests {
       /* reliable_writer */ true,
       /* is_builtin */ false,
       /* volatile */ true,
+      /* keep_last */ false,
       /* window_limit */ 1000,
       /* backlog_limit */ 1000,
       max_retain,
