@@ -3,50 +3,17 @@
 //!
 //! `cargo bench --bench replay`
 
-use mcap::records::MessageHeader;
+#[path = "common/joint_state_bag.rs"]
+mod joint_state_bag;
+
+use joint_state_bag::write_joint_state_bag;
 use oorandom::Rand64;
-use std::collections::BTreeMap;
-use std::io::BufWriter;
-use std::path::Path;
 use std::time::Instant;
 use thickness_collision::checker::Checker;
 use thickness_collision::model::Params;
-use thickness_collision::msgs::{Header, JointState, Time};
-use thickness_collision::replay::encode_cdr_le;
 use thickness_collision::replay::{replay, ReplayOptions};
 
 const STATES: usize = 100_000;
-
-fn write_bag(dir: &Path, states: &[(Vec<String>, Vec<f64>)]) {
-    std::fs::create_dir_all(dir).unwrap();
-    let file = std::fs::File::create(dir.join("bench_0.mcap")).unwrap();
-    let mut w = mcap::WriteOptions::new().profile("ros2").create(BufWriter::new(file)).unwrap();
-    let def = "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n";
-    let schema = w.add_schema("sensor_msgs/msg/JointState", "ros2msg", def.as_bytes()).unwrap();
-    let ch = w.add_channel(schema, "/joint_states", "cdr", &BTreeMap::new()).unwrap();
-    let t0: i64 = 1_700_000_000_000_000_000;
-    for (k, (name, position)) in states.iter().enumerate() {
-        let t = t0 + k as i64 * 1_000_000;
-        let msg = JointState {
-            header: Header { stamp: Time::from_nanos(t), frame_id: String::new() },
-            name: name.clone(),
-            position: position.clone(),
-            velocity: vec![],
-            effort: vec![],
-        };
-        w.write_to_known_channel(&MessageHeader { channel_id: ch, sequence: k as u32, log_time: t as u64, publish_time: t as u64 }, &encode_cdr_le(&msg))
-            .unwrap();
-    }
-    let _ = w.finish().unwrap();
-    std::fs::write(
-        dir.join("metadata.yaml"),
-        format!(
-            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths:\n    - bench_0.mcap\n  message_count: {}\n",
-            states.len()
-        ),
-    )
-    .unwrap();
-}
 
 fn main() {
     let checker = Checker::from_params(Params::default(), None, None).unwrap();
@@ -68,7 +35,7 @@ fn main() {
     let root = std::env::temp_dir().join(format!("tc_bench_replay_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&root);
     let bag = root.join("in");
-    write_bag(&bag, &states);
+    let _ = write_joint_state_bag(&bag, "bench", 1_000_000, states);
     let size = std::fs::metadata(bag.join("bench_0.mcap")).unwrap().len();
 
     println!("replay of {STATES} joint states of the bundled arm against the bundled workcell ({:.1} MB MCAP)", size as f64 / 1e6);

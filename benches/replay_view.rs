@@ -9,33 +9,26 @@
 //! `cargo bench --bench replay_view` (`ROUNDS=n` to change the 3 rounds; `BAGS=random` or
 //! `BAGS=sweep` for one of the two)
 
-use mcap::records::MessageHeader;
+#[path = "common/joint_state_bag.rs"]
+mod joint_state_bag;
+
+use joint_state_bag::write_joint_state_bag;
 use oorandom::Rand64;
-use std::collections::BTreeMap;
-use std::io::BufWriter;
 use std::path::Path;
 use std::time::Instant;
 use thickness_collision::checker::Checker;
 use thickness_collision::model::Params;
-use thickness_collision::msgs::{Header, JointState, Time};
-use thickness_collision::replay::encode_cdr_le;
 use thickness_collision::replay::{replay, ReplayOptions};
 
 const STATES: usize = 360_000;
 const PERIOD_NS: i64 = 10_000_000;
 
+/// The hour: random states within the limits, or the path of scripts/example_recording.sh.
 fn write_bag(dir: &Path, checker: &Checker, sweep: bool) {
-    std::fs::create_dir_all(dir).unwrap();
-    let file = std::fs::File::create(dir.join("hour_0.mcap")).unwrap();
-    let mut w = mcap::WriteOptions::new().profile("ros2").create(BufWriter::new(file)).unwrap();
-    let def = "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n";
-    let schema = w.add_schema("sensor_msgs/msg/JointState", "ros2msg", def.as_bytes()).unwrap();
-    let ch = w.add_channel(schema, "/joint_states", "cdr", &BTreeMap::new()).unwrap();
     let joints: Vec<_> = checker.robot().joints.iter().filter(|j| j.is_actuated()).collect();
+    let names: Vec<String> = joints.iter().map(|j| j.name.clone()).collect();
     let mut rng = Rand64::new(42);
-    let t0: i64 = 1_700_000_000_000_000_000;
-    for k in 0..STATES {
-        let t = t0 + k as i64 * PERIOD_NS;
+    let states = (0..STATES).map(|k| {
         let s = k as f64 / 100.0 * 1.5;
         // The path of scripts/example_recording.sh, fingers closed.
         let path = [1.2 * (0.9 * s).sin(), 0.7 + 0.6 * (2.1 * s).sin(), 0.3 + 0.6 * (1.3 * s + 0.5).sin(), 0.8 * (1.7 * s).sin(), 0.5 * (1.1 * s).cos(), 0.0];
@@ -51,24 +44,9 @@ fn write_bag(dir: &Path, checker: &Checker, sweep: bool) {
                 }
             })
             .collect();
-        let msg = JointState {
-            header: Header { stamp: Time::from_nanos(t), frame_id: String::new() },
-            name: joints.iter().map(|j| j.name.clone()).collect(),
-            position,
-            velocity: vec![],
-            effort: vec![],
-        };
-        w.write_to_known_channel(&MessageHeader { channel_id: ch, sequence: k as u32, log_time: t as u64, publish_time: t as u64 }, &encode_cdr_le(&msg))
-            .unwrap();
-    }
-    let _ = w.finish().unwrap();
-    std::fs::write(
-        dir.join("metadata.yaml"),
-        format!(
-            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths:\n    - hour_0.mcap\n  message_count: {STATES}\n"
-        ),
-    )
-    .unwrap();
+        (names.clone(), position)
+    });
+    let _ = write_joint_state_bag(dir, "hour", PERIOD_NS, states);
 }
 
 fn dir_size(d: &Path) -> u64 {
