@@ -90,13 +90,7 @@ fn main() {
         let links = robot.forward_kinematics(&q, &nalgebra::Isometry3::identity()).unwrap();
         for (ti, _, offset) in &parts {
             let p = thickness_collision::math::pose_from_isometry(&links[checker.targets()[*ti].link]) * *offset;
-            let m = glam::DMat3::from_quat(p.rotation);
-            for r in 0..3 {
-                for c in 0..3 {
-                    poses.push(m.col(c)[r]);
-                }
-            }
-            poses.extend_from_slice(&p.translation.to_array());
+            poses.extend_from_slice(&thickness_collision::math::pose_rows(&p));
         }
     }
     write_raw(&dir.join("poses.f64"), &poses);

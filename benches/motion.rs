@@ -198,13 +198,7 @@ fn coal_moveit(
             let links = robot.forward_kinematics(&along(q0, q1, k as f64 / (MOVEIT_STATES - 1) as f64), checker.base_pose()).unwrap();
             for (ti, _, offset) in &parts {
                 let p = pose_from_isometry(&links[checker.targets()[*ti].link]) * *offset;
-                let m = glam::DMat3::from_quat(p.rotation);
-                for r in 0..3 {
-                    for c in 0..3 {
-                        poses.push(m.col(c)[r]);
-                    }
-                }
-                poses.extend_from_slice(&p.translation.to_array());
+                poses.extend_from_slice(&thickness_collision::math::pose_rows(&p));
             }
         }
     }

@@ -179,13 +179,7 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
             .collect();
         for (ti, _, offset) in &parts {
             let p = world_links[checker.targets()[*ti].link] * *offset;
-            let m = glam::DMat3::from_quat(p.rotation);
-            for r in 0..3 {
-                for c in 0..3 {
-                    poses.push(m.col(c)[r]);
-                }
-            }
-            poses.extend_from_slice(&p.translation.to_array());
+            poses.extend_from_slice(&thickness_collision::math::pose_rows(&p));
         }
         link_poses.push(world_links);
     }

@@ -79,13 +79,7 @@ fn main() {
         let world = robot.forward_kinematics(q, checker.base_pose()).unwrap();
         for &(ti, pi) in &parts {
             let p = thickness_collision::math::pose_from_isometry(&world[targets[ti].link]) * targets[ti].parts[pi].1;
-            let m = glam::DMat3::from_quat(p.rotation);
-            for r in 0..3 {
-                for c in 0..3 {
-                    poses.push(m.col(c)[r]);
-                }
-            }
-            poses.extend_from_slice(&p.translation.to_array());
+            poses.extend_from_slice(&thickness_collision::math::pose_rows(&p));
         }
     }
     write_raw(&dir.join("poses.f64"), &poses);

@@ -43,9 +43,47 @@ pub fn intersect_three_planes(n: [Vector; 3], d: [Real; 3], eps: Real) -> Option
     }
 }
 
+/// A pose as the Python peers read it (`tests/peers/hull_parts.py`, coal's `Transform3s`): the
+/// rotation matrix row by row, then the translation.
+pub fn pose_rows(p: &Pose) -> [Real; 12] {
+    // glam's `DMat3::from_quat`, term for term, so the peers see the matrices they always saw.
+    let q = p.rotation;
+    let (x2, y2, z2) = (q.x + q.x, q.y + q.y, q.z + q.z);
+    let (xx, xy, xz) = (q.x * x2, q.x * y2, q.x * z2);
+    let (yy, yz, zz) = (q.y * y2, q.y * z2, q.z * z2);
+    let (wx, wy, wz) = (q.w * x2, q.w * y2, q.w * z2);
+    let t = p.translation;
+    #[rustfmt::skip]
+    let rows = [
+        1.0 - (yy + zz), xy - wz, xz + wy,
+        xy + wz, 1.0 - (xx + zz), yz - wx,
+        xz - wy, yz + wx, 1.0 - (xx + yy),
+        t.x, t.y, t.z,
+    ];
+    rows
+}
+
 /// nalgebra (kinematics) to parry/glam (geometry): the one conversion point.
 pub fn pose_from_isometry(iso: &nalgebra::Isometry3<Real>) -> Pose {
     let q = iso.rotation.quaternion();
     let t = iso.translation.vector;
     Pose::from_parts(Vector::new(t.x, t.y, t.z), Rotation::from_xyzw(q.i, q.j, q.k, q.w))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pose_rows_are_glams_matrix_row_by_row() {
+        let mut rng = oorandom::Rand64::new(7);
+        for _ in 0..1000 {
+            let mut r = || rng.rand_float() * 2.0 - 1.0;
+            let q = Rotation::from_xyzw(r(), r(), r(), r()).normalize();
+            let p = Pose::from_parts(Vector::new(r(), r(), r()), q);
+            let m = glam::DMat3::from_quat(q);
+            let want: Vec<Real> = (0..3).flat_map(|row| (0..3).map(move |c| m.col(c)[row])).chain(p.translation.to_array()).collect();
+            assert_eq!(pose_rows(&p).to_vec(), want);
+        }
+    }
 }

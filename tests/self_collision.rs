@@ -121,13 +121,7 @@ fn compare(name: &str, urdf: &str, srdf: &str, n: usize, seed: u64) -> Outcome {
         let world = robot.forward_kinematics(&q, checker.base_pose()).unwrap();
         for &(ti, pi) in &parts {
             let p = thickness_collision::math::pose_from_isometry(&world[targets[ti].link]) * targets[ti].parts[pi].1;
-            let m = glam::DMat3::from_quat(p.rotation);
-            for r in 0..3 {
-                for c in 0..3 {
-                    poses.push(m.col(c)[r]);
-                }
-            }
-            poses.extend_from_slice(&p.translation.to_array());
+            poses.extend_from_slice(&thickness_collision::math::pose_rows(&p));
         }
     }
     assert_eq!(disabled_reported.get(), 0, "{name}: a pair the SRDF disables was reported");

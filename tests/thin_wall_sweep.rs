@@ -72,10 +72,7 @@ fn a_link_behind_the_wall_is_caught_where_coal_misses_it() {
         .iter()
         .map(|p| {
             let rel = wall_pose.inv_mul(p);
-            let m = glam::DMat3::from_quat(rel.rotation);
-            let mut v: Vec<f64> = (0..3).flat_map(|r| (0..3).map(move |c| m.col(c)[r])).collect();
-            v.extend_from_slice(&rel.translation.to_array());
-            v
+            thickness_collision::math::pose_rows(&rel).to_vec()
         })
         .collect();
     let mesh_json = |v: &[Vector], t: &[[u32; 3]]| json!({"vertices": v.iter().map(|p| p.to_array()).collect::<Vec<_>>(), "triangles": t});
