@@ -20,7 +20,7 @@ use common::fastdds::{FastDdsPeer, PeerOptions};
 use common::start_node;
 use serde_json::{json, Value};
 use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Child, ChildStdout, Command};
 
 const NAMES: [&str; 7] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
@@ -42,36 +42,14 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 /// `check --states FILE --json` (plus `extra`) on JSON lines; one report per line.
-fn check_cli(dir: &Path, name: &str, lines: &[Value], extra: &[&str]) -> Vec<Value> {
-    let file = dir.join(format!("{name}.jsonl"));
-    let text: Vec<String> = lines.iter().map(Value::to_string).collect();
-    std::fs::write(&file, text.join("\n") + "\n").unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--states", file.to_str().unwrap(), "--json"]).args(extra).output().unwrap();
-    assert!(o.status.success(), "check: {}", String::from_utf8_lossy(&o.stderr));
-    String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect()
-}
-
-fn close(a: &Value, b: &Value) -> bool {
-    match (a.as_f64(), b.as_f64()) {
-        (Some(x), Some(y)) => (x - y).abs() <= 1e-9,
-        _ => a.as_array().zip(b.as_array()).is_some_and(|(x, y)| x.len() == y.len() && x.iter().zip(y).all(|(p, q)| close(p, q))),
-    }
-}
-
 /// A report (topic or `check_states`) equals check's: collision, and each contact's link, object,
 /// triangle, depth, point and normal.
 fn assert_same_report(got: &Value, want: &Value, what: &str) {
     assert_eq!(want["error"], "", "{what}: check could not check it: {want}");
-    assert_eq!((&got["in_collision"], &got["error"]), (&want["in_collision"], &json!("")), "{what}: {got} vs {want}");
-    let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
-    assert_eq!(g.len(), w.len(), "{what}: contacts {got} vs {want}");
-    for (a, b) in g.iter().zip(w) {
-        for k in ["link_name", "object_name", "triangle", "object_type"] {
-            assert_eq!(a[k], b[k], "{what}: {k}");
-        }
-        for k in ["depth", "position", "normal"] {
-            assert!(close(&a[k], &b[k]), "{what}: {k}: {a} vs {b}");
-        }
+    assert_eq!(got["error"], "", "{what}: {got}");
+    common::same_report(got, want, what);
+    for (a, b) in got["contacts"].as_array().unwrap().iter().zip(want["contacts"].as_array().unwrap()) {
+        assert_eq!(a["object_type"], b["object_type"], "{what}: object_type");
     }
 }
 
@@ -102,7 +80,7 @@ fn fastdds_topics_services_parameters_and_latched_markers() {
     // Joint states in (a reliable keep-last-10 writer, as joint_state_broadcaster offers them,
     // matched by the node's best-effort reader), reports out.
     let states: Vec<Value> = (0..25).map(|k| state_json(k, 1_000_000_000 + k as i64)).collect();
-    let reference = check_cli(&dir, "states", &states, &[]);
+    let reference = common::check_json(&dir, "states", &states, &[]);
     assert!(reference.iter().any(|r| r["in_collision"] == true) && reference.iter().any(|r| r["in_collision"] == false));
     let a = peer.send(&json!({"cmd": "states", "states": states, "warm": {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}, "timeout": 30}));
     assert_eq!(a["matched"], true, "no match on joint_states/collisions: {a}");
@@ -153,7 +131,7 @@ fn fastdds_topics_services_parameters_and_latched_markers() {
         let got = &ans["response"];
         assert!(got.is_object(), "trajectory {n}: no answer: {ans}");
         let lines: Vec<Value> = t.iter().map(|&k| json!({"name": NAMES, "position": state(k)})).collect();
-        let cli = check_cli(&dir, &format!("trajectory{n}"), &lines, &["--motion"]);
+        let cli = common::check_json(&dir, &format!("trajectory{n}"), &lines, &["--motion"]);
         assert_eq!(got["error"], "", "trajectory {n}: {got}");
         match cli.iter().enumerate().skip(1).find(|(_, l)| l["in_collision"] == true) {
             None => assert_eq!((&got["valid"], &got["segment"]), (&json!(true), &json!(-1)), "trajectory {n}: {got}"),
@@ -165,7 +143,7 @@ fn fastdds_topics_services_parameters_and_latched_markers() {
                 assert_eq!(g.len(), w.len(), "trajectory {n}");
                 for (a, b) in g.iter().zip(w) {
                     assert_eq!((&a["link_name"], &a["object_name"]), (&b["link_name"], &b["object_name"]), "trajectory {n}");
-                    assert!(close(&a["depth"], &b["depth"]), "trajectory {n}: depth");
+                    assert!(common::close(&a["depth"], &b["depth"]), "trajectory {n}: depth");
                 }
             }
         }
@@ -185,7 +163,10 @@ fn fastdds_topics_services_parameters_and_latched_markers() {
         assert_eq!(g.len(), w.len(), "state {k}: {got}");
         for (a, b) in g.iter().zip(w) {
             assert_eq!((&a["body_1"], &a["body_2"], &a["type_1"]), (&b["link_name"], &b["object_name"], &json!(0)), "state {k}");
-            assert!(close(&a["depth"], &b["depth"]) && close(&a["position"], &b["position"]) && close(&a["normal"], &b["normal"]), "state {k}");
+            assert!(
+                common::close(&a["depth"], &b["depth"]) && common::close(&a["position"], &b["position"]) && common::close(&a["normal"], &b["normal"]),
+                "state {k}"
+            );
         }
     }
     eprintln!("services answered ({:.1} s)", t0.elapsed().as_secs_f64());
@@ -298,7 +279,7 @@ fn fastdds_tf_input_equals_check_with_transforms() {
         tf_states.push(json!({"stamp": 2_000_000_000 + k, "transforms": tfs}));
         lines.push(json!({"transforms": line}));
     }
-    let reference = check_cli(&dir, "tf", &lines, &[]);
+    let reference = common::check_json(&dir, "tf", &lines, &[]);
     assert!(reference.iter().any(|r| r["in_collision"] == true) && reference.iter().any(|r| r["in_collision"] == false));
     let mut warm = tf_states[0].clone();
     warm["stamp"] = json!(1);
@@ -322,8 +303,8 @@ fn fastdds_latched_robot_description_is_taken_by_a_node_started_after_it() {
     let fat = dir.join("fat_arm.urdf");
     std::fs::write(&fat, &urdf).unwrap();
     let states: Vec<Value> = (0..15).map(|k| state_json(k, k as i64 + 10)).collect();
-    let thin = check_cli(&dir, "thin", &states, &[]);
-    let fat_ref = check_cli(&dir, "fat", &states, &["--robot", fat.to_str().unwrap()]);
+    let thin = common::check_json(&dir, "thin", &states, &[]);
+    let fat_ref = common::check_json(&dir, "fat", &states, &["--robot", fat.to_str().unwrap()]);
     let colliding = |v: &[Value]| v.iter().filter(|r| r["in_collision"] == true).count();
     assert!(colliding(&fat_ref) > colliding(&thin), "the fat forearm must collide more often");
 

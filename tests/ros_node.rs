@@ -103,26 +103,10 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     assert_eq!(answer["set_results"][1][0], true, "{}", answer["set_results"]);
     assert_eq!(answer["get_after"], json!(0.2));
 
-    let same = |got: &Value, want: &Value, what: &str| {
-        assert_eq!(got["in_collision"], want["in_collision"], "{what}");
-        let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
-        assert_eq!(g.len(), w.len(), "{what}: colliding links");
-        for (a, b) in g.iter().zip(w) {
-            assert_eq!(a["link_name"], b["link_name"], "{what}");
-            assert_eq!(a["object_name"], b["object_name"], "{what}");
-            assert_eq!(a["triangle"], b["triangle"], "{what}");
-            assert!((a["depth"].as_f64().unwrap() - b["depth"].as_f64().unwrap()).abs() <= 1e-9, "{what}: depth");
-            for k in ["position", "normal"] {
-                for i in 0..3 {
-                    assert!((a[k][i].as_f64().unwrap() - b[k][i].as_f64().unwrap()).abs() <= 1e-9, "{what}: {k}");
-                }
-            }
-        }
-    };
     let reports = answer["reports"].as_array().unwrap();
     assert_eq!(reports.len(), states.len(), "one report per state sent one at a time");
     for (k, (got, want)) in reports.iter().zip(&reference).enumerate() {
-        same(got, want, &format!("topic, state {k}"));
+        common::same_report(got, want, &format!("topic, state {k}"));
         assert_eq!(got["stamp"].as_i64().unwrap(), 1_000_000_000 + k as i64, "stamped with the input's stamp");
         assert_eq!(got["error"], "", "a checked state has no error");
         assert_eq!(got["frame_id"], "world");
@@ -137,7 +121,7 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     }
     let good: Vec<&Value> = service.iter().enumerate().filter(|(k, _)| *k != 1 && *k != 3).map(|(_, v)| v).collect();
     for (k, (got, want)) in good.iter().zip(&reference).enumerate() {
-        same(got, want, &format!("service, state {k}"));
+        common::same_report(got, want, &format!("service, state {k}"));
         assert_eq!(got["error"], "", "service, state {k}");
     }
 

@@ -13,28 +13,10 @@ mod common;
 use common::start_node;
 use oorandom::Rand64;
 use serde_json::{json, Value};
-use std::path::Path;
-use std::process::Command;
 use thickness_collision::checker::Checker;
 use thickness_collision::model::{JointKind, Params};
 
 /// `check --states FILE --json` on states given by name: one report per state.
-fn check_cli(dir: &Path, names: &[String], states: &[Vec<f64>]) -> Vec<Value> {
-    let lines: Vec<String> = states.iter().map(|p| json!({"name": names, "position": p}).to_string()).collect();
-    let file = dir.join("states.jsonl");
-    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--states", file.to_str().unwrap(), "--json"]).output().unwrap();
-    assert!(o.status.success(), "check: {}", String::from_utf8_lossy(&o.stderr));
-    String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect()
-}
-
-fn close(a: &Value, b: &Value) -> bool {
-    match (a.as_f64(), b.as_f64()) {
-        (Some(x), Some(y)) => (x - y).abs() <= 1e-9,
-        _ => a.as_array().zip(b.as_array()).is_some_and(|(x, y)| x.len() == y.len() && x.iter().zip(y).all(|(p, q)| close(p, q))),
-    }
-}
-
 /// The service's answer against `check --json` on the same state: `valid` is "not in
 /// collision", and each contact is the report's (link as body 1, a robot link; the object as body
 /// 2, a world object, or a robot link for a self contact; depth, point and normal; in
@@ -49,7 +31,10 @@ fn assert_same(k: usize, got: &Value, cli: &Value) {
         // ROBOT_LINK 0, WORLD_OBJECT 1: a self contact's object is another link.
         let type_2 = if c["object_type"] == "robot_link" { json!(0) } else { json!(1) };
         assert_eq!((&g["body_1"], &g["type_1"], &g["body_2"], &g["type_2"]), (&c["link_name"], &json!(0), &c["object_name"], &type_2), "state {k}");
-        assert!(close(&g["depth"], &c["depth"]) && close(&g["position"], &c["position"]) && close(&g["normal"], &c["normal"]), "state {k}: {g} vs {c}");
+        assert!(
+            common::close(&g["depth"], &c["depth"]) && common::close(&g["position"], &c["position"]) && common::close(&g["normal"], &c["normal"]),
+            "state {k}: {g} vs {c}"
+        );
         assert_eq!(g["frame"], "world", "state {k}");
     }
 }
@@ -76,7 +61,8 @@ fn check_state_validity_agrees_with_check_and_refuses_what_it_cannot_honour() {
                 .collect()
         })
         .collect();
-    let cli = check_cli(&dir, &names, &states);
+    let lines: Vec<Value> = states.iter().map(|p| json!({"name": names, "position": p})).collect();
+    let cli = common::check_json(&dir, "states", &lines, &[]);
     assert_eq!(cli.len(), states.len());
     let colliding = cli.iter().filter(|l| l["in_collision"] == true).count();
     assert!(colliding >= 5 && colliding + 5 <= states.len(), "{colliding} of {} states collide: the test needs both kinds", states.len());

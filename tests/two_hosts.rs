@@ -130,23 +130,6 @@ fn stop(mut node: Child, mut out: std::io::BufReader<std::process::ChildStdout>)
     (status, rest, err)
 }
 
-fn same(got: &Value, want: &Value, what: &str) {
-    assert_eq!(got["in_collision"], want["in_collision"], "{what}");
-    let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
-    assert_eq!(g.len(), w.len(), "{what}: colliding links");
-    for (a, b) in g.iter().zip(w) {
-        assert_eq!(a["link_name"], b["link_name"], "{what}");
-        assert_eq!(a["object_name"], b["object_name"], "{what}");
-        assert_eq!(a["triangle"], b["triangle"], "{what}");
-        assert!((a["depth"].as_f64().unwrap() - b["depth"].as_f64().unwrap()).abs() <= 1e-9, "{what}: depth");
-        for k in ["position", "normal"] {
-            for i in 0..3 {
-                assert!((a[k][i].as_f64().unwrap() - b[k][i].as_f64().unwrap()).abs() <= 1e-9, "{what}: {k}");
-            }
-        }
-    }
-}
-
 /// The exchange across the link, with the Cyclone peer and then the Fast DDS peer in host B
 /// (`fast_peers`: the Fast DDS peer's initial peers): states on `joint_states`, reports on
 /// `collisions`, a `check_states` call and the parameter services; every answer checked.
@@ -179,14 +162,14 @@ fn exchange_across_the_link(hosts: &TwoHosts, domain: u32, node_env: &[(&str, Op
     let reports = answer["reports"].as_array().unwrap();
     assert_eq!(reports.len(), states.len(), "one report per state, across the link");
     for (k, (got, w)) in reports.iter().zip(&want).enumerate() {
-        same(got, w, &format!("topic, state {k}"));
+        common::same_report(got, w, &format!("topic, state {k}"));
         assert_eq!(got["stamp"].as_i64().unwrap(), 1_000_000_000 + k as i64, "stamped with the input's stamp");
         assert_eq!(got["error"], "");
     }
     let service = answer["service"].as_array().unwrap();
     assert_eq!(service.len(), 4, "check_states answers every state: {answer}");
     for (k, (got, w)) in service.iter().zip(&want).enumerate() {
-        same(got, w, &format!("service, state {k}"));
+        common::same_report(got, w, &format!("service, state {k}"));
     }
 
     let t = Instant::now();
@@ -216,14 +199,14 @@ fn fastdds_in_b(hosts: &TwoHosts, domain: u32, peers: &[&str], states: &[(Vec<&s
         return Err(format!("{} reports for {} states: {a}", reports.len(), states.len()));
     }
     for (k, (got, w)) in reports.iter().zip(want).enumerate() {
-        same(got, w, &format!("Fast DDS topic, state {k}"));
+        common::same_report(got, w, &format!("Fast DDS topic, state {k}"));
         assert_eq!(got["stamp"].as_i64(), Some(2_000_000_000 + k as i64), "stamped with the input's stamp");
     }
     let answers = peer.call("check_states", "check_states", vec![json!({"states": js[..4].to_vec()})], 20.0);
     let got = answers[0]["response"]["reports"].as_array().cloned().ok_or_else(|| format!("check_states: no answer: {}", answers[0]))?;
     assert_eq!(got.len(), 4, "Fast DDS check_states: {}", answers[0]);
     for (k, (g, w)) in got.iter().zip(want).enumerate() {
-        same(g, w, &format!("Fast DDS check_states, state {k}"));
+        common::same_report(g, w, &format!("Fast DDS check_states, state {k}"));
     }
     let get = |peer: &mut FastDdsPeer| -> Result<Value, String> {
         let a = peer.call("tc_two/get_parameters", "get_parameters", vec![json!({"names": ["default_thickness"]})], 20.0);

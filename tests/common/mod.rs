@@ -143,3 +143,38 @@ pub fn fat_arm_urdf() -> String {
         .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", gripper.display()))
         .replace("<capsule radius=\"0.04\"", "<capsule radius=\"0.3\"")
 }
+
+/// Numbers within 1e-9 (metres, here), arrays element by element.
+pub fn close(a: &serde_json::Value, b: &serde_json::Value) -> bool {
+    match (a.as_f64(), b.as_f64()) {
+        (Some(x), Some(y)) => (x - y).abs() <= 1e-9,
+        _ => a.as_array().zip(b.as_array()).is_some_and(|(x, y)| x.len() == y.len() && x.iter().zip(y).all(|(p, q)| close(p, q))),
+    }
+}
+
+/// `check --states <dir>/<name>.jsonl --json` plus `extra` on `lines`: the reference reports, one
+/// per line.
+pub fn check_json(dir: &Path, name: &str, lines: &[serde_json::Value], extra: &[&str]) -> Vec<serde_json::Value> {
+    let file = dir.join(format!("{name}.jsonl"));
+    let text: Vec<String> = lines.iter().map(serde_json::Value::to_string).collect();
+    std::fs::write(&file, text.join("\n") + "\n").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--states", file.to_str().unwrap(), "--json"]).args(extra).output().unwrap();
+    assert!(o.status.success(), "check: {}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+}
+
+/// A report the node sent (topic or `check_states`, as a peer printed it) equals `check`'s:
+/// collision, and each contact's link, object and triangle, its depth, point and normal to 1e-9 m.
+pub fn same_report(got: &serde_json::Value, want: &serde_json::Value, what: &str) {
+    assert_eq!(got["in_collision"], want["in_collision"], "{what}: {got} vs {want}");
+    let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
+    assert_eq!(g.len(), w.len(), "{what}: colliding links, {got} vs {want}");
+    for (a, b) in g.iter().zip(w) {
+        for k in ["link_name", "object_name", "triangle"] {
+            assert_eq!(a[k], b[k], "{what}: {k}");
+        }
+        for k in ["depth", "position", "normal"] {
+            assert!(close(&a[k], &b[k]), "{what}: {k}: {a} vs {b}");
+        }
+    }
+}
