@@ -84,17 +84,19 @@ mod tests {
         // glibc keeps until trimmed (a free at the top would be returned on its own).
         let mut blocks = Vec::new();
         let mut pins = Vec::new();
-        for _ in 0..2048 {
+        // 256 MiB: the other unit tests run beside this one in the same process, and their own
+        // memory moves the resident size by tens of MiB.
+        for _ in 0..8192 {
             blocks.push(vec![1u8; 32 << 10]);
             pins.push(vec![1u8; 64]);
         }
         let grown = resident_bytes().expect("statm");
-        assert!(grown >= before + (48 << 20), "the burst did not show in the resident size: {before} -> {grown}");
+        assert!(grown >= before + (192 << 20), "the burst did not show in the resident size: {before} -> {grown}");
         drop(blocks);
         let kept = resident_bytes().expect("statm");
-        let returned = m.tick().expect("a trim after 64 MiB of growth");
+        let returned = m.tick().expect("a trim after 256 MiB of growth");
         let after = resident_bytes().expect("statm");
-        assert!(after + (32 << 20) < kept, "resident {kept} -> {after} after the trim ({returned} bytes returned)");
+        assert!(after + (128 << 20) < kept, "resident {kept} -> {after} after the trim ({returned} bytes returned)");
         drop(pins);
     }
 }
