@@ -7,7 +7,7 @@
 //! as an hour of robot work is. Prints a table per bag, the SVG's size and element count.
 //!
 //! `cargo bench --bench replay_view` (`ROUNDS=n` to change the 3 rounds; `BAGS=random` or
-//! `BAGS=sweep` for one of the two)
+//! `BAGS=sweep` for one of the two; `KEEP_BAG=DIR` only writes the bags into DIR, for profiling)
 
 #[path = "common/joint_state_bag.rs"]
 mod joint_state_bag;
@@ -85,6 +85,15 @@ fn main() {
 fn scenario(root: &Path, checker: &Checker, sweep: bool, rounds: usize) {
     let bag = root.join(if sweep { "sweep" } else { "random" });
     write_bag(&bag, checker, sweep);
+    // `KEEP_BAG=DIR`: the bag is moved there and nothing is timed, to profile `replay` on it.
+    if let Ok(keep) = std::env::var("KEEP_BAG") {
+        let to = Path::new(&keep).join(if sweep { "sweep" } else { "random" });
+        let _ = std::fs::remove_dir_all(&to);
+        std::fs::create_dir_all(&keep).unwrap();
+        std::fs::rename(&bag, &to).or_else(|_| std::process::Command::new("cp").arg("-r").arg(&bag).arg(&to).status().map(|_| ())).unwrap();
+        println!("bag kept in {}", to.display());
+        return;
+    }
     let what = if sweep { "a smooth sweep, motions checked (the default parameters)" } else { "random joint states, each checked on its own" };
     println!("\none hour at 100 Hz: {STATES} states of the bundled arm, {what} ({:.1} MB MCAP)", dir_size(&bag) as f64 / 1e6);
     let configs =

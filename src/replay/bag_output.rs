@@ -25,6 +25,10 @@ const BATCH: usize = 256;
 /// Batches queued before the loop waits for the writer: enough to ride out a slow write, few
 /// enough that memory stays small (a job is a report and a dozen poses).
 const QUEUE: usize = 16;
+// Written batches go back to the loop to be freed there. The loop allocated every report and
+// pose; freed on the writer thread they went back to the loop's malloc arena under its lock, and
+// the two threads took turns on it: with the markers on, malloc and free were a fifth of the
+// loop's time and the wake-ups doubled (perf, docs/benchmarks.md).
 
 /// What the writer thread is asked to write.
 enum Job {
@@ -56,6 +60,8 @@ enum Copied {
 /// The loop's side of the output bag.
 pub(super) struct OutputBag {
     jobs: Option<SyncSender<Vec<Job>>>,
+    /// Batches the writer is done with, to empty (and free) on the loop's thread and reuse.
+    done: Receiver<Vec<Job>>,
     batch: Vec<Job>,
     writer: Option<JoinHandle<Result<()>>>,
     view: Option<ViewState>,
@@ -120,9 +126,12 @@ impl OutputBag {
             poses_of: None,
         });
         let (jobs, queue) = sync_channel(QUEUE);
+        // Room for every batch there can be: the writer never waits to hand one back.
+        let (done_tx, done) = sync_channel(QUEUE + 2);
         let writer = Writer { bag, world: world.to_owned(), collisions, topics, poses: TfMessage::default() };
-        let handle = std::thread::Builder::new().name("bag writer".into()).spawn(move || writer.run(queue)).context("cannot start the bag writer thread")?;
-        Ok(OutputBag { jobs: Some(jobs), batch: Vec::with_capacity(BATCH), writer: Some(handle), view: state })
+        let handle =
+            std::thread::Builder::new().name("bag writer".into()).spawn(move || writer.run(queue, done_tx)).context("cannot start the bag writer thread")?;
+        Ok(OutputBag { jobs: Some(jobs), done, batch: Vec::with_capacity(BATCH), writer: Some(handle), view: state })
     }
 
     fn send(&mut self, job: Job) -> Result<()> {
@@ -134,7 +143,18 @@ impl OutputBag {
     }
 
     fn flush(&mut self) -> Result<()> {
-        let batch = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH));
+        let next = match self.done.try_recv() {
+            Ok(mut written) => {
+                written.clear();
+                written
+            }
+            Err(_) => Vec::with_capacity(BATCH),
+        };
+        // Any further returned batches are freed here too.
+        while let Ok(written) = self.done.try_recv() {
+            drop(written);
+        }
+        let batch = std::mem::replace(&mut self.batch, next);
         let sent = self.jobs.as_ref().map(|j| j.send(batch));
         match sent {
             Some(Ok(())) => Ok(()),
@@ -210,46 +230,50 @@ impl OutputBag {
 }
 
 impl Writer {
-    fn run(mut self, queue: Receiver<Vec<Job>>) -> Result<()> {
-        for job in queue.into_iter().flatten() {
-            self.write(job)?;
+    fn run(mut self, queue: Receiver<Vec<Job>>, done: SyncSender<Vec<Job>>) -> Result<()> {
+        for batch in queue {
+            for job in &batch {
+                self.write(job)?;
+            }
+            // Never blocks: if the loop has stopped taking them, the batch is freed here.
+            let _ = done.try_send(batch);
         }
         let _ = self.bag.finish()?;
         Ok(())
     }
 
-    fn write(&mut self, job: Job) -> Result<()> {
+    fn write(&mut self, job: &Job) -> Result<()> {
         let topics = self.topics.as_ref();
         match (job, topics) {
             (Job::Report { checked, poses, log_time }, _) => {
-                self.bag.write(self.collisions, &checked.message(&self.world), log_time)?;
+                self.bag.write(self.collisions, &checked.message(&self.world), *log_time)?;
                 let Some(t) = topics else { return Ok(()) };
                 // Lifetime zero: each report's DELETEALL replaces the one before, however far apart.
                 let markers = contact_markers(&checked.report, &self.world, checked.stamp, DurationMsg::default());
-                self.bag.write_with(t.contacts, |w| w.marker_array(&markers), log_time)?;
+                self.bag.write_with(t.contacts, |w| w.marker_array(&markers), *log_time)?;
                 if let Some(poses) = poses {
                     for (entry, pose) in self.poses.transforms.iter_mut().zip(poses) {
                         entry.header.stamp = checked.stamp;
-                        entry.transform = pose;
+                        entry.transform = *pose;
                     }
                     let poses = &self.poses;
-                    self.bag.write_with(t.tf, |w| w.tf_message(poses), log_time)?;
+                    self.bag.write_with(t.tf, |w| w.tf_message(poses), *log_time)?;
                 }
                 Ok(())
             }
             (Job::Frames(tf), _) => {
-                self.poses = tf;
+                self.poses = tf.clone();
                 Ok(())
             }
-            (Job::Cells(cells, log_time), Some(t)) => self.bag.write(t.cells, &cells, log_time),
-            (Job::Description(d, log_time), Some(t)) => self.bag.write(t.description, &d, log_time),
+            (Job::Cells(cells, log_time), Some(t)) => self.bag.write(t.cells, cells, *log_time),
+            (Job::Description(d, log_time), Some(t)) => self.bag.write(t.description, d, *log_time),
             (Job::Raw { topic, data, log_time }, Some(t)) => {
                 let id = match topic {
                     Copied::Tf => t.tf,
                     Copied::TfStatic => t.tf_static,
                     Copied::Description => t.description,
                 };
-                self.bag.write_raw(id, &data, log_time)
+                self.bag.write_raw(id, data, *log_time)
             }
             // Viewer messages are only made with the viewer topics.
             (_, None) => Ok(()),

@@ -2,7 +2,7 @@
 //! collides, gathered as the bag streams by (`replay --plot`; drawn by `timeline_svg`).
 
 use crate::checker::StateReport;
-use std::collections::{BTreeSet, HashSet};
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// Bars kept per link before neighbours are merged. A flickering contact at 100 Hz for an hour
 /// makes 180,000 runs; the picture cannot show more than one per few pixels anyway, and memory
@@ -25,8 +25,9 @@ pub struct TimelineBar {
     pub state_hit: bool,
     /// Deepest contact of the link in the run (metres).
     pub depth: f64,
-    /// Objects (or links, for self-collision) the link touched.
-    pub objects: BTreeSet<String>,
+    /// Objects (or links, for self-collision) the link touched, as numbers into
+    /// [`Timeline::objects`].
+    pub objects: BarObjects,
     /// Runs merged into this bar (1: none).
     pub runs: u64,
 }
@@ -38,14 +39,50 @@ impl TimelineBar {
     }
 
     /// Takes `next` (later) into this bar.
-    pub fn absorb(&mut self, next: TimelineBar) {
+    pub fn absorb(&mut self, next: &TimelineBar) {
         self.end = next.end;
         self.states.1 = next.states.1;
         self.colliding += next.colliding;
         self.state_hit |= next.state_hit;
         self.depth = self.depth.max(next.depth);
-        self.objects.extend(next.objects);
+        self.objects.extend(&next.objects);
         self.runs += next.runs;
+    }
+}
+
+/// The objects of a bar. Almost every bar touches one object, kept without an allocation: a
+/// flickering contact makes a bar every few reports, and a heap node per bar (a `BTreeSet` of
+/// names, as it was) slowed every allocation of the replay loop by a fifth (docs/benchmarks.md).
+#[derive(Clone, Debug, PartialEq)]
+pub enum BarObjects {
+    One(u32),
+    Many(BTreeSet<u32>),
+}
+
+impl BarObjects {
+    fn insert(&mut self, id: u32) {
+        match self {
+            BarObjects::One(o) if *o == id => {}
+            BarObjects::One(o) => *self = BarObjects::Many(BTreeSet::from([*o, id])),
+            BarObjects::Many(set) => {
+                let _ = set.insert(id);
+            }
+        }
+    }
+
+    fn extend(&mut self, other: &BarObjects) {
+        match other {
+            BarObjects::One(id) => self.insert(*id),
+            BarObjects::Many(set) => set.iter().for_each(|id| self.insert(*id)),
+        }
+    }
+
+    /// The numbers, ascending.
+    pub fn ids(&self) -> Vec<u32> {
+        match self {
+            BarObjects::One(o) => vec![*o],
+            BarObjects::Many(set) => set.iter().copied().collect(),
+        }
     }
 }
 
@@ -76,6 +113,9 @@ pub struct Timeline {
     pub last_seconds: f64,
     /// The deepest contact.
     pub deepest: Option<TimelineDeepest>,
+    /// The names of the objects the bars touched, numbered in the order first met.
+    pub objects: Vec<String>,
+    object_ids: HashMap<String, u32>,
 }
 
 impl Timeline {
@@ -91,6 +131,23 @@ impl Timeline {
                 let bar = self.rows.iter().find(|r| r.link == c.link_name).and_then(|r| r.bars.last());
                 !bar.is_some_and(|b| b.state_hit && b.states.1 + 1 >= n)
             })
+    }
+
+    /// The names of a bar's objects, sorted.
+    pub fn object_names(&self, bar: &TimelineBar) -> Vec<&str> {
+        let mut names: Vec<&str> = bar.objects.ids().into_iter().filter_map(|id| self.objects.get(id as usize).map(String::as_str)).collect();
+        names.sort_unstable();
+        names
+    }
+
+    fn object_id(&mut self, name: &str) -> u32 {
+        if let Some(id) = self.object_ids.get(name) {
+            return *id;
+        }
+        let id = self.objects.len() as u32;
+        self.objects.push(name.to_owned());
+        let _ = self.object_ids.insert(name.to_owned(), id);
+        id
     }
 
     /// Motion-only runs (bars) in the picture's rows.
@@ -115,17 +172,22 @@ impl Timeline {
             if self.deepest.as_ref().is_none_or(|d| c.depth > d.4) {
                 self.deepest = Some((seconds, n, c.link_name.clone(), c.object_name.clone(), c.depth));
             }
+            let object = self.object_id(&c.object_name);
             let row = match self.rows.iter().position(|r| r.link == c.link_name) {
                 Some(i) => &mut self.rows[i],
                 None => {
-                    self.rows.push(TimelineRow { link: c.link_name.clone(), bars: Vec::new(), merged_within: 0.0 });
+                    // Full size at once: the row's bars are never moved to a larger block.
+                    self.rows.push(TimelineRow { link: c.link_name.clone(), bars: Vec::with_capacity(MAX_BARS_KEPT + 1), merged_within: 0.0 });
                     let last = self.rows.len() - 1;
                     &mut self.rows[last]
                 }
             };
             match row.bars.last_mut() {
                 // A second contact of the same link in the same report.
-                Some(b) if b.states.1 == n => b.depth = b.depth.max(c.depth),
+                Some(b) if b.states.1 == n => {
+                    b.depth = b.depth.max(c.depth);
+                    b.objects.insert(object);
+                }
                 // The run goes on; or, once bars are merged to bound memory, a close one joins.
                 Some(b) if b.states.1 + 1 == n || seconds - b.end < row.merged_within => {
                     b.runs += (b.states.1 + 1 != n) as u64;
@@ -134,6 +196,7 @@ impl Timeline {
                     b.colliding += 1;
                     b.state_hit |= state_hit;
                     b.depth = b.depth.max(c.depth);
+                    b.objects.insert(object);
                 }
                 _ => row.bars.push(TimelineBar {
                     start: seconds,
@@ -142,15 +205,9 @@ impl Timeline {
                     colliding: 1,
                     state_hit,
                     depth: c.depth,
-                    objects: BTreeSet::new(),
+                    objects: BarObjects::One(object),
                     runs: 1,
                 }),
-            }
-            // Most contacts extend a bar that already names their object: no string is cloned.
-            if let Some(b) = row.bars.last_mut() {
-                if !b.objects.contains(&c.object_name) {
-                    let _ = b.objects.insert(c.object_name.clone());
-                }
             }
             if row.bars.len() > MAX_BARS_KEPT {
                 row.coarsen();
@@ -165,7 +222,7 @@ impl TimelineRow {
         let span = self.bars.last().map_or(0.0, |b| b.end) - self.bars.first().map_or(0.0, |b| b.start);
         let mut gap = (span / MAX_BARS_KEPT as f64).max(self.merged_within * 2.0).max(1e-9);
         loop {
-            self.bars = merge_bars(std::mem::take(&mut self.bars), |a, b| b.start - a.end < gap);
+            merge_bars_in_place(&mut self.bars, |a, b| b.start - a.end < gap);
             if self.bars.len() <= MAX_BARS_KEPT / 2 {
                 break;
             }
@@ -175,12 +232,27 @@ impl TimelineRow {
     }
 }
 
+/// [`merge_bars`] within the vector, which keeps its block.
+fn merge_bars_in_place(bars: &mut Vec<TimelineBar>, close: impl Fn(&TimelineBar, &TimelineBar) -> bool) {
+    let mut kept = 0;
+    for i in 0..bars.len() {
+        if kept > 0 && close(&bars[kept - 1], &bars[i]) {
+            let (before, after) = bars.split_at_mut(i);
+            before[kept - 1].absorb(&after[0]);
+        } else {
+            bars.swap(kept, i);
+            kept += 1;
+        }
+    }
+    bars.truncate(kept);
+}
+
 /// Merges each bar into the one before it while `close(before, bar)`.
 pub fn merge_bars(bars: Vec<TimelineBar>, close: impl Fn(&TimelineBar, &TimelineBar) -> bool) -> Vec<TimelineBar> {
     let mut out: Vec<TimelineBar> = Vec::with_capacity(bars.len());
     for b in bars {
         match out.last_mut() {
-            Some(last) if close(last, &b) => last.absorb(b),
+            Some(last) if close(last, &b) => last.absorb(&b),
             _ => out.push(b),
         }
     }

@@ -115,7 +115,7 @@ fn draw(root: &DrawingArea<SVGBackend, Shift>, t: &Timeline, bag: &str) -> Resul
                 let h = ((bottom - top - 2) as f64 * b.depth / max_depth).round().max(1.0) as i32;
                 root.draw(&Rectangle::new([(x0, bottom - h), (x1, bottom)], color.mix(0.85).filled()))?;
             }
-            drawn.push(DrawnBar { rect: (x0, top, x1 - x0, bottom - top), title: tooltip(&row.link, b) });
+            drawn.push(DrawnBar { rect: (x0, top, x1 - x0, bottom - top), title: tooltip(&row.link, b, &t.object_names(b)) });
         }
     }
     Ok(drawn)
@@ -123,7 +123,7 @@ fn draw(root: &DrawingArea<SVGBackend, Shift>, t: &Timeline, bag: &str) -> Resul
 
 /// The bar's tooltip: link, time span, report numbers, what it stands for and its objects. The
 /// first line is the same for every bar, so a reader (or a test) can parse it.
-fn tooltip(link: &str, b: &TimelineBar) -> String {
+fn tooltip(link: &str, b: &TimelineBar, objects: &[&str]) -> String {
     let kind = if b.motion_only() { "motion-only" } else { "in collision" };
     let merged = if b.runs > 1 { format!(", {} runs merged", b.runs) } else { String::new() };
     format!(
@@ -134,7 +134,7 @@ fn tooltip(link: &str, b: &TimelineBar) -> String {
         b.states.1,
         b.colliding,
         b.depth * 1e3,
-        b.objects.iter().map(String::as_str).collect::<Vec<_>>().join(", ")
+        objects.join(", ")
     )
 }
 
