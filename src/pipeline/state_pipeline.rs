@@ -233,42 +233,13 @@ impl Pipeline {
         CheckedState { stamp: to.stamp, report }
     }
 
-    /// The world pose of every link of a joint state (forward kinematics, as the check computed
-    /// them) as a `/tf` message into `out`: `world_frame` to each link's frame (`frame_prefix` +
-    /// name), stamped with the state. False (and `out` untouched) for a state made of link poses:
-    /// its `/tf` came with the input.
-    ///
-    /// The frame names already in `out` are kept (a replay writing one message per state then
-    /// allocates no strings): pass an empty message after the checker changed
-    /// ([`Pipeline::checker`] is another `Arc`), or the names may be another robot's.
-    pub fn link_transforms(&self, state: &RobotState, out: &mut TfMessage) -> bool {
-        let StatePose::Joints(q) = &state.pose else { return false };
-        let robot = self.checker.robot();
-        // A state this pipeline accepted has a position for every joint: FK cannot fail on it.
-        let Ok(poses) = robot.forward_kinematics(q, self.checker.base_pose()) else { return false };
-        let (world, prefix) = (&self.params().world_frame, &self.params().frame_prefix);
-        // A root link named like the world frame would be its own parent.
-        let own = world.strip_prefix(prefix.as_str()).and_then(|name| robot.link(name));
-        let links = robot.links.iter().zip(&poses).enumerate().filter(|(i, _)| Some(*i) != own).map(|(_, l)| l);
-        let mut n = 0;
-        for (link, pose) in links {
-            // The length alone is compared: comparing the names cost 7 % of a replay.
-            if out.transforms.get(n).is_none_or(|t| t.child_frame_id.len() != prefix.len() + link.name.len()) {
-                out.transforms.truncate(n);
-                out.transforms.push(TransformStamped {
-                    header: Header { stamp: state.stamp, frame_id: world.clone() },
-                    child_frame_id: format!("{prefix}{}", link.name),
-                    transform: Transform::default(),
-                });
-            }
-            let (t, r) = (pose.translation.vector, pose.rotation.coords);
-            let entry = &mut out.transforms[n];
-            entry.header.stamp = state.stamp;
-            entry.transform = Transform { translation: Vector3 { x: t.x, y: t.y, z: t.z }, rotation: Quaternion { x: r.x, y: r.y, z: r.z, w: r.w } };
-            n += 1;
+    /// The joint positions of a state made from a joint state (None for one made of link poses:
+    /// its `/tf` came with the input). With [`link_transforms`] they give the state's `/tf`.
+    pub fn joint_positions<'a>(&self, state: &'a RobotState) -> Option<&'a [f64]> {
+        match &state.pose {
+            StatePose::Joints(q) => Some(q),
+            StatePose::Links(_) => None,
         }
-        out.transforms.truncate(n);
-        true
     }
 
     /// The URDF text of the robot in force, for viewers that draw it: the `robot_description`
@@ -435,4 +406,38 @@ impl std::fmt::Debug for Pipeline {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Pipeline").field("source", &self.source).field("skipped", &self.skipped).finish_non_exhaustive()
     }
+}
+
+/// The world pose of every link at joint positions `q` of `checker`'s robot (forward kinematics,
+/// as the check computes them) as a `/tf` message into `out`: `world` to each link's frame
+/// (`prefix` + name), stamped `stamp`. False (and `out` untouched) when `q` does not fit the robot.
+///
+/// The frame names already in `out` are kept (a replay writing one message per state then
+/// allocates no strings): pass an empty message after the checker changed, or the names may be
+/// another robot's.
+pub fn link_transforms(checker: &Checker, world: &str, prefix: &str, q: &[f64], stamp: Time, out: &mut TfMessage) -> bool {
+    let robot = checker.robot();
+    let Ok(poses) = robot.forward_kinematics(q, checker.base_pose()) else { return false };
+    // A root link named like the world frame would be its own parent.
+    let own = world.strip_prefix(prefix).and_then(|name| robot.link(name));
+    let links = robot.links.iter().zip(&poses).enumerate().filter(|(i, _)| Some(*i) != own).map(|(_, l)| l);
+    let mut n = 0;
+    for (link, pose) in links {
+        // The length alone is compared: comparing the names cost 7 % of a replay.
+        if out.transforms.get(n).is_none_or(|t| t.child_frame_id.len() != prefix.len() + link.name.len()) {
+            out.transforms.truncate(n);
+            out.transforms.push(TransformStamped {
+                header: Header { stamp, frame_id: world.to_owned() },
+                child_frame_id: format!("{prefix}{}", link.name),
+                transform: Transform::default(),
+            });
+        }
+        let (t, r) = (pose.translation.vector, pose.rotation.coords);
+        let entry = &mut out.transforms[n];
+        entry.header.stamp = stamp;
+        entry.transform = Transform { translation: Vector3 { x: t.x, y: t.y, z: t.z }, rotation: Quaternion { x: r.x, y: r.y, z: r.z, w: r.w } };
+        n += 1;
+    }
+    out.transforms.truncate(n);
+    true
 }

@@ -8,8 +8,8 @@ use super::bag_writer::{BagWriter, TopicId};
 use crate::checker::Checker;
 use crate::markers::{cell_markers, contact_markers};
 use crate::model::PoseSource;
-use crate::msgs::{DurationMsg, MarkerArray, StringMsg, TfMessage, Time, Transform, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};
-use crate::pipeline::{CheckedState, Pipeline, RobotState};
+use crate::msgs::{DurationMsg, MarkerArray, StringMsg, TfMessage, Time, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};
+use crate::pipeline::{link_transforms, CheckedState, Pipeline, RobotState};
 use anyhow::{anyhow, Context, Result};
 use std::path::Path;
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
@@ -40,12 +40,14 @@ enum Job {
     },
     Cells(MarkerArray, i64),
     Description(StringMsg, i64),
-    /// The frame names of the `/tf` to come (after the robot changed), with the first poses.
-    Frames(TfMessage),
-    /// A report, and the link poses it was checked at (joint-state input with the view on).
+    /// The robot of the joint positions to come (at the start, and after it changed), with the
+    /// world frame and the frame prefix its `/tf` is written with.
+    Robot(Arc<Checker>, String, String),
+    /// A report, and the joint positions it was checked at (joint-state input with the view on):
+    /// the writer computes the link poses, so the loop pays for one small copy.
     Report {
         checked: CheckedState,
-        poses: Option<Vec<Transform>>,
+        joints: Option<Vec<f64>>,
         log_time: i64,
     },
 }
@@ -77,9 +79,8 @@ struct ViewState {
     copy_description: bool,
     /// The cells (and the robot's file) are written with the first message.
     started: bool,
-    /// The last `/tf` made, and the checker it was made for (its frame names are reused).
-    poses: TfMessage,
-    poses_of: Option<Arc<Checker>>,
+    /// The robot the writer was last told of.
+    robot: Option<Arc<Checker>>,
 }
 
 /// The writer thread's state.
@@ -88,7 +89,9 @@ struct Writer {
     world: String,
     collisions: TopicId,
     topics: Option<ViewTopics>,
-    /// The `/tf` message written per report: names set by `Job::Frames`, poses by each report.
+    /// The robot, world frame and prefix of the joint positions in reports (`Job::Robot`).
+    robot: Option<(Arc<Checker>, String, String)>,
+    /// The `/tf` message written per report, reused: its frame names stay while the robot does.
     poses: TfMessage,
 }
 
@@ -122,13 +125,12 @@ impl OutputBag {
             copy_tf: pose_source == PoseSource::Tf,
             copy_description: has(DESCRIPTION_TOPIC, STRING_TYPE),
             started: false,
-            poses: TfMessage::default(),
-            poses_of: None,
+            robot: None,
         });
         let (jobs, queue) = sync_channel(QUEUE);
         // Room for every batch there can be: the writer never waits to hand one back.
         let (done_tx, done) = sync_channel(QUEUE + 2);
-        let writer = Writer { bag, world: world.to_owned(), collisions, topics, poses: TfMessage::default() };
+        let writer = Writer { bag, world: world.to_owned(), collisions, topics, robot: None, poses: TfMessage::default() };
         let handle =
             std::thread::Builder::new().name("bag writer".into()).spawn(move || writer.run(queue, done_tx)).context("cannot start the bag writer thread")?;
         Ok(OutputBag { jobs: Some(jobs), done, batch: Vec::with_capacity(BATCH), writer: Some(handle), view: state })
@@ -191,27 +193,24 @@ impl OutputBag {
         jobs.into_iter().try_for_each(|j| self.send(j))
     }
 
-    /// A report, and (for joint states, with the view on) the link poses it was checked at.
+    /// A report, and (for joint states, with the view on) the joint positions it was checked at.
     pub(super) fn report(&mut self, pipeline: &Pipeline, state: &RobotState, checked: CheckedState, log_time: i64) -> Result<()> {
-        let mut poses = None;
-        let mut frames = None;
+        let mut joints = None;
+        let mut robot = None;
         if let Some(view) = self.view.as_mut().filter(|v| !v.copy_tf) {
-            if !view.poses_of.as_ref().is_some_and(|c| Arc::ptr_eq(c, pipeline.checker())) {
-                view.poses = TfMessage::default();
-                view.poses_of = Some(pipeline.checker().clone());
-            }
-            let fresh = view.poses.transforms.is_empty();
-            if pipeline.link_transforms(state, &mut view.poses) {
-                if fresh {
-                    frames = Some(view.poses.clone());
+            if let Some(q) = pipeline.joint_positions(state) {
+                if !view.robot.as_ref().is_some_and(|c| Arc::ptr_eq(c, pipeline.checker())) {
+                    view.robot = Some(pipeline.checker().clone());
+                    let params = pipeline.params();
+                    robot = Some(Job::Robot(pipeline.checker().clone(), params.world_frame.clone(), params.frame_prefix.clone()));
                 }
-                poses = Some(view.poses.transforms.iter().map(|t| t.transform).collect());
+                joints = Some(q.to_vec());
             }
         }
-        if let Some(f) = frames {
-            self.send(Job::Frames(f))?;
+        if let Some(r) = robot {
+            self.send(r)?;
         }
-        self.send(Job::Report { checked, poses, log_time })
+        self.send(Job::Report { checked, joints, log_time })
     }
 
     /// Waits for the writer to write everything, finish the MCAP file and `metadata.yaml`.
@@ -245,24 +244,24 @@ impl Writer {
     fn write(&mut self, job: &Job) -> Result<()> {
         let topics = self.topics.as_ref();
         match (job, topics) {
-            (Job::Report { checked, poses, log_time }, _) => {
+            (Job::Report { checked, joints, log_time }, _) => {
                 self.bag.write(self.collisions, &checked.message(&self.world), *log_time)?;
                 let Some(t) = topics else { return Ok(()) };
                 // Lifetime zero: each report's DELETEALL replaces the one before, however far apart.
                 let markers = contact_markers(&checked.report, &self.world, checked.stamp, DurationMsg::default());
                 self.bag.write_with(t.contacts, |w| w.marker_array(&markers), *log_time)?;
-                if let Some(poses) = poses {
-                    for (entry, pose) in self.poses.transforms.iter_mut().zip(poses) {
-                        entry.header.stamp = checked.stamp;
-                        entry.transform = *pose;
+                if let (Some(q), Some((checker, world, prefix))) = (joints, &self.robot) {
+                    if link_transforms(checker, world, prefix, q, checked.stamp, &mut self.poses) {
+                        let poses = &self.poses;
+                        self.bag.write_with(t.tf, |w| w.tf_message(poses), *log_time)?;
                     }
-                    let poses = &self.poses;
-                    self.bag.write_with(t.tf, |w| w.tf_message(poses), *log_time)?;
                 }
                 Ok(())
             }
-            (Job::Frames(tf), _) => {
-                self.poses = tf.clone();
+            (Job::Robot(checker, world, prefix), _) => {
+                self.robot = Some((checker.clone(), world.clone(), prefix.clone()));
+                // Another robot's frame names must not be reused.
+                self.poses = TfMessage::default();
                 Ok(())
             }
             (Job::Cells(cells, log_time), Some(t)) => self.bag.write(t.cells, cells, *log_time),
