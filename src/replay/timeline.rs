@@ -311,6 +311,30 @@ mod tests {
     }
 
     #[test]
+    fn a_bar_names_every_object_its_link_touched_also_after_merging() {
+        let mut t = Timeline::default();
+        let on = |object: &str| StateReport {
+            in_collision: true,
+            contacts: vec![ReportContact { object_name: object.into(), ..hit(&[("a", 0.01)]).contacts[0].clone() }],
+            ..Default::default()
+        };
+        // Runs: [shelf, guard] at reports 1-2, then guard alone at 4, then many short runs of guard.
+        t.record(0.0, &on("shelf"), None);
+        t.record(0.01, &on("guard"), None);
+        t.record(0.02, &hit(&[]), None);
+        t.record(0.03, &on("guard"), None);
+        assert_eq!(t.object_names(&t.rows[0].bars[0]), ["guard", "shelf"]);
+        assert_eq!(t.object_names(&t.rows[0].bars[1]), ["guard"]);
+        for k in 0..2 * MAX_BARS_KEPT {
+            t.record(0.04 + k as f64 * 0.01, &if k % 2 == 0 { hit(&[]) } else { on("guard") }, None);
+        }
+        let bars = &t.rows[0].bars;
+        assert!(bars.len() <= MAX_BARS_KEPT / 2 + 1, "{} bars", bars.len());
+        assert_eq!(t.object_names(&bars[0]), ["guard", "shelf"], "the first bar absorbed its neighbours and kept both objects");
+        assert_eq!(bars.iter().map(|b| b.colliding).sum::<u64>(), 3 + MAX_BARS_KEPT as u64);
+    }
+
+    #[test]
     fn a_flickering_link_is_merged_to_bounded_bars() {
         let mut t = Timeline::default();
         for k in 0..200_000 {
