@@ -354,6 +354,13 @@ const MAX_STATES_PER_TURN: usize = 256;
 /// Joint states the reader keeps while the node is busy.
 const STATES_KEPT: usize = 100;
 
+/// Joint states taken in one turn that get a report each. A stall of the machine of a few
+/// milliseconds leaves a handful waiting, and the node answers them all (as replay does, one
+/// report per state) and catches up; more than this waiting means it is behind, and the oldest
+/// share one report (the polyline through them) so the newest are answered sooner. At 10 kHz,
+/// one report per turn cost 1 % of the states their own answer (docs/latency.md).
+const SEPARATE_REPORTS: usize = 32;
+
 /// The loop's housekeeping period (`/rosout`, `/diagnostics`, the summary for a forced stop).
 const TICK: Duration = Duration::from_millis(100);
 
@@ -481,9 +488,10 @@ impl NodeState {
     }
 
     /// Joint states: everything already waiting (up to [`MAX_STATES_PER_TURN`]) goes through the
-    /// pipeline in order (merging partial states), and one report covers the good ones (the
-    /// polyline through them with `check_motion`, else the newest, older ones stale). A waiting
-    /// sample that does not decode is counted and skipped.
+    /// pipeline in order (merging partial states). The newest [`SEPARATE_REPORTS`] - 1 good ones
+    /// get a report each; one report covers all older ones (the polyline through them with
+    /// `check_motion`, else the newest of them, the others stale). A waiting sample that does not
+    /// decode is counted and skipped.
     async fn on_joint_states(&mut self, io: &Interfaces, first: JointState) {
         let mut batch = vec![first];
         while batch.len() < MAX_STATES_PER_TURN {
@@ -502,7 +510,14 @@ impl NodeState {
             }
         }
         self.warn_pending();
-        self.publish_report(io, &good).await;
+        let shared = good.len().saturating_sub(SEPARATE_REPORTS - 1).max(good.len().min(1));
+        let (older, newest) = good.split_at(shared);
+        if !older.is_empty() {
+            self.publish_report(io, older).await;
+        }
+        for state in newest {
+            self.publish_report(io, std::slice::from_ref(state)).await;
+        }
     }
 
     async fn on_tf(&mut self, io: &Interfaces, msg: TfMessage) {

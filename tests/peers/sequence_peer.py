@@ -16,6 +16,8 @@ stdout (live): {"reports": [...], "diagnostics": {key: value}}; (bag): {"ok": tr
 Loopback only: the caller sets CYCLONEDDS_URI (127.0.0.1, no multicast, peer 127.0.0.1).
 """
 import json
+import os
+import signal
 import sys
 import time
 from pathlib import Path
@@ -55,7 +57,7 @@ def live(req):
     reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(1000))
     sensor = Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(10))
     latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(100))
-    topics = {m["topic"] for m in req["messages"]}
+    topics = {m["topic"] for m in req["messages"] if "topic" in m}
     writers = {}
     if "/joint_states" in topics:
         writers["/joint_states"] = (DataWriter(dp, Topic(dp, f"rt{ns}/joint_states", T.JointState), qos=sensor), js)
@@ -92,6 +94,11 @@ def live(req):
         return got
 
     def send(m):
+        # {"signal": "STOP" or "CONT", "pid": n}: stop or resume a process (the node, to make it
+        # fall behind the way a stalled machine does).
+        if "signal" in m:
+            os.kill(m["pid"], getattr(signal, "SIG" + m["signal"]))
+            return
         w, make = writers[m["topic"]]
         w.write(make(m))
 

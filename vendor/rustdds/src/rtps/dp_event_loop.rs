@@ -314,6 +314,11 @@ impl DPEventLoop {
       let poll_timeout = timeout_until(ev_wrapper.shared_timer.borrow().next_deadline(), idle_cap);
       match ev_wrapper.poll.poll(&mut events, Some(poll_timeout)) {
         Ok(_) => {}
+        // thickness_collision change 11: epoll_wait fails with EINTR when the process is
+        // stopped and continued (SIGSTOP/SIGCONT: Ctrl-Z and fg, a debugger, a stalled
+        // container), even without a signal handler. That is no failure: wait again. Ending
+        // the loop here left the participant deaf and mute for good.
+        Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
         Err(e) => {
           error!("dp_event_loop poll failed: {e:?}");
           break;
