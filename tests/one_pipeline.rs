@@ -319,9 +319,9 @@ fn check_path(order: &[usize], motion: bool, d: &Path) -> Vec<Value> {
 }
 
 /// Issue 12: states the node falls behind on. The node answers a few states waiting at once with a
-/// report each (as replay does); past 32 it is behind, and the oldest share one report, which must
+/// report each (as replay does); past 64 it is behind, and the oldest share one report, which must
 /// cover every state in it. Each round stops the node (SIGSTOP, as a stalled machine would), sends
-/// A, B and 40 states C back to back, and resumes it: B is among the oldest, and the report that
+/// A, B and 80 states C back to back, and resumes it: B is among the oldest, and the report that
 /// covers it must cover the polyline A → B → C, not only its newest state. With
 /// `check_motion:=false` the same rounds show what is missed without it. The node must also come
 /// back from each stop: unpatched, RustDDS's event loops ended at the first SIGCONT (EINTR,
@@ -338,8 +338,8 @@ fn a_state_the_node_falls_behind_on_is_still_covered_by_the_next_report() {
     assert!(through[1]["in_collision"] == true && through[2]["in_collision"] == true, "A -> B -> C: {through:?}");
 
     const ROUNDS: usize = 30;
-    // More than the 32 states the node answers one by one.
-    const CS: usize = 40;
+    // More than the 64 states the node answers one by one.
+    const CS: usize = 80;
     let messages = |pid: u32, b_stamps: &mut Vec<i64>| {
         let mut messages = Vec::new();
         let mut k = 0;
@@ -402,12 +402,12 @@ fn a_state_the_node_falls_behind_on_is_still_covered_by_the_next_report() {
             reports.len(),
             (2 + CS) * ROUNDS
         );
-        // Resumed with 42 states waiting, the node answers the newest 31 on their own and the
-        // oldest 11 with one report: most rounds must show that (RustDDS may hand over the
+        // Resumed with 82 states waiting, the node answers the newest 63 on their own and the
+        // oldest 19 with one report: most rounds must show that (RustDDS may hand over the
         // waiting states in more than one turn, when B can come in a turn of its own).
         assert!(skipped_b >= ROUNDS / 2, "B was reported on its own in {} of {ROUNDS} rounds: {reports:?}", ROUNDS - skipped_b);
         assert!(
-            reports.len() >= ROUNDS * (CS - 10),
+            reports.len() >= ROUNDS * (CS - 20),
             "{} reports for {ROUNDS} rounds of {} states: the states waiting were not answered one by one",
             reports.len(),
             2 + CS
