@@ -15,8 +15,10 @@ pub(super) struct MemoryReturn {
 }
 
 impl MemoryReturn {
+    /// Starts measuring growth from the resident size now. The node also fixes the allocator's
+    /// thresholds first ([`fix_allocator_thresholds`]), or freed blocks may stay where no trim
+    /// reaches them.
     pub(super) fn new() -> MemoryReturn {
-        fixed_thresholds();
         MemoryReturn { baseline: resident_bytes().unwrap_or(0) }
     }
 
@@ -59,7 +61,7 @@ fn trim() {}
 /// does not reach it (it trims only the main arena's top). Fixed thresholds keep large blocks
 /// in mmaps of their own, given back when freed.
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn fixed_thresholds() {
+pub(super) fn fix_allocator_thresholds() {
     // SAFETY: mallopt only sets the allocator's tunables; called before the node's threads
     // allocate much, and safe at any time.
     unsafe {
@@ -69,7 +71,7 @@ fn fixed_thresholds() {
 }
 
 #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn fixed_thresholds() {}
+pub(super) fn fix_allocator_thresholds() {}
 
 #[cfg(test)]
 mod tests {
@@ -77,6 +79,8 @@ mod tests {
 
     #[test]
     fn a_freed_burst_is_handed_back() {
+        // As the node starts.
+        fix_allocator_thresholds();
         let mut m = MemoryReturn::new();
         let before = resident_bytes().expect("statm");
         // Blocks below glibc's mmap threshold (so they live in an arena), touched, each followed

@@ -7,7 +7,7 @@
 
 use super::diagnostics::{diagnostics, NodeStats};
 use super::discovery_range::DiscoverySettings;
-use super::memory_return::MemoryReturn;
+use super::memory_return::{self, MemoryReturn};
 use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
 use super::param_services::{ros_mapping, ParamRequest, ParamRequests, ParamServers};
 use super::param_values::{declarations, to_json, READ_ONLY};
@@ -719,6 +719,8 @@ impl NodeState {
 
 /// Runs the node until Ctrl-C or SIGTERM.
 pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
+    // Before the model is built and DDS starts its threads: the thresholds apply from here on.
+    memory_return::fix_allocator_thresholds();
     let params = params.with_overrides(&opts.ros_args.params)?;
     let pipeline = Pipeline::new(params, opts.robot.as_deref(), opts.environment.as_deref())?;
     let (dp, domain, discovery) = participant()?;
