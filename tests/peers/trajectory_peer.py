@@ -27,6 +27,7 @@ from cyclonedds.util import duration
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import dds_types as d  # noqa: E402
+import service_client  # noqa: E402
 
 req = json.load(sys.stdin)
 dp = DomainParticipant(req["domain"])
@@ -76,24 +77,8 @@ while (states_w.get_matched_subscriptions() == [] or reports_r.get_matched_publi
        or resp_r.get_matched_publications() == []) and time.time() < end:
     time.sleep(0.05)
 out = {"state_report": None, "answers": [], "long": None}
-seq = 0
-
-
-def send(tr):
-    global seq
-    seq += 1
-    req_w.write(d.TrajRequest(guid=GUID, seq=seq, trajectory=trajectory(tr)))
-    return seq
-
-
-def wait_answer(k, wait):
-    stop = time.time() + wait
-    while time.time() < stop:
-        for x in resp_r.take(N=10):
-            if int(x.seq) == k:
-                return x
-        time.sleep(0.005)
-    return None
+client = service_client.Client(req_w, resp_r, lambda tr, seq: d.TrajRequest(guid=GUID, seq=seq, trajectory=trajectory(tr)))
+send, wait_answer = client.send, client.wait_answer
 
 
 # Warm-up: a request written before the node matched us is lost, so a refused request (answered
@@ -123,10 +108,7 @@ for tr in req.get("trajectories", []):
 # sending of the state it is stamped with), measured from when the request has been written.
 if req.get("long"):
     reports_r.take(N=1000)
-    seq += 1
-    k = seq
-    message = d.TrajRequest(guid=GUID, seq=k, trajectory=trajectory(req["long"]))
-    req_w.write(message)
+    k = send(req["long"])
     t0 = time.time()
     answer, answered_at, arrivals, latencies, sent_at = None, None, [], [], {}
     stream = req.get("stream", [])

@@ -25,6 +25,7 @@ from cyclonedds.util import duration
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import moveit_types as m  # noqa: E402
+import service_client  # noqa: E402
 
 req = json.load(sys.stdin)
 dp = DomainParticipant(req["domain"])
@@ -77,24 +78,8 @@ diag_r = DataReader(dp, Topic(dp, "rt/diagnostics", m.DiagnosticArray), qos=reli
 end = time.time() + timeout
 while (req_w.get_matched_subscriptions() == [] or resp_r.get_matched_publications() == []) and time.time() < end:
     time.sleep(0.05)
-seq = 0
-
-
-def send(r):
-    global seq
-    seq += 1
-    req_w.write(request(r, seq))
-    return seq
-
-
-def wait_answer(k, wait):
-    stop = time.time() + wait
-    while time.time() < stop:
-        for x in resp_r.take(N=10):
-            if int(x.seq) == k:
-                return x
-        time.sleep(0.005)
-    return None
+client = service_client.Client(req_w, resp_r, request)
+send, wait_answer = client.send, client.wait_answer
 
 
 # Warm-up: a request written before the node matched us is lost, so an empty request (the node's
