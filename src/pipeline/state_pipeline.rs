@@ -41,6 +41,17 @@ pub struct RobotState {
     follows: bool,
 }
 
+impl RobotState {
+    /// The joint positions of a state made from a joint state (None for one made of link poses:
+    /// its `/tf` came with the input). With [`link_transforms`] they give the state's `/tf`.
+    pub fn joint_positions(&self) -> Option<&[f64]> {
+        match &self.pose {
+            StatePose::Joints(q) => Some(q),
+            StatePose::Links(_) => None,
+        }
+    }
+}
+
 impl PartialEq for RobotState {
     fn eq(&self, other: &RobotState) -> bool {
         self.stamp == other.stamp && self.pose == other.pose
@@ -231,15 +242,6 @@ impl Pipeline {
             _ => StateReport { motion: true, ..StateReport::failed("a motion between a joint state and link poses cannot be checked") },
         };
         CheckedState { stamp: to.stamp, report }
-    }
-
-    /// The joint positions of a state made from a joint state (None for one made of link poses:
-    /// its `/tf` came with the input). With [`link_transforms`] they give the state's `/tf`.
-    pub fn joint_positions<'a>(&self, state: &'a RobotState) -> Option<&'a [f64]> {
-        match &state.pose {
-            StatePose::Joints(q) => Some(q),
-            StatePose::Links(_) => None,
-        }
     }
 
     /// The URDF text of the robot in force, for viewers that draw it: the `robot_description`

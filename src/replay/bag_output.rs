@@ -25,10 +25,6 @@ const BATCH: usize = 256;
 /// Batches queued before the loop waits for the writer: enough to ride out a slow write, few
 /// enough that memory stays small (a job is a report and a dozen poses).
 const QUEUE: usize = 16;
-// Written batches go back to the loop to be freed there. The loop allocated every report and
-// pose; freed on the writer thread they went back to the loop's malloc arena under its lock, and
-// the two threads took turns on it: with the markers on, malloc and free were a fifth of the
-// loop's time and the wake-ups doubled (perf, docs/benchmarks.md).
 
 /// What the writer thread is asked to write.
 enum Job {
@@ -40,9 +36,8 @@ enum Job {
     },
     Cells(MarkerArray, i64),
     Description(StringMsg, i64),
-    /// The robot of the joint positions to come (at the start, and after it changed), with the
-    /// world frame and the frame prefix its `/tf` is written with.
-    Robot(Arc<Checker>, String, String),
+    /// The robot of the joint positions to come (at the start, and after it changed).
+    Robot(Arc<Checker>),
     /// A report, and the joint positions it was checked at (joint-state input with the view on):
     /// the writer computes the link poses, so the loop pays for one small copy.
     Report {
@@ -62,7 +57,10 @@ enum Copied {
 /// The loop's side of the output bag.
 pub(super) struct OutputBag {
     jobs: Option<SyncSender<Vec<Job>>>,
-    /// Batches the writer is done with, to empty (and free) on the loop's thread and reuse.
+    /// Batches the writer is done with, emptied (and freed) here on the loop's thread and reused.
+    /// The loop allocated every report in them; freed on the writer thread they went back to the
+    /// loop's malloc arena under its lock, and the two threads took turns on it: with the markers
+    /// on, malloc and free were a fifth of the loop's time (perf, docs/benchmarks.md).
     done: Receiver<Vec<Job>>,
     batch: Vec<Job>,
     writer: Option<JoinHandle<Result<()>>>,
@@ -87,10 +85,12 @@ struct ViewState {
 struct Writer {
     bag: BagWriter,
     world: String,
+    /// Put before each link's name in `/tf`.
+    frame_prefix: String,
     collisions: TopicId,
     topics: Option<ViewTopics>,
-    /// The robot, world frame and prefix of the joint positions in reports (`Job::Robot`).
-    robot: Option<(Arc<Checker>, String, String)>,
+    /// The robot of the joint positions in reports (`Job::Robot`).
+    robot: Option<Arc<Checker>>,
     /// The `/tf` message written per report, reused: its frame names stay while the robot does.
     poses: TfMessage,
 }
@@ -105,8 +105,16 @@ struct ViewTopics {
 
 impl OutputBag {
     /// Creates the bag in `dir` (which must not exist) and starts its writer. `view`: the
-    /// markers, `/tf` and `/robot_description` beside `/collisions`.
-    pub(super) fn create(dir: &Path, input_topics: &[(String, String)], pose_source: PoseSource, world: &str, view: bool) -> Result<OutputBag> {
+    /// markers, `/tf` and `/robot_description` beside `/collisions`; `world` and `frame_prefix`
+    /// name the frames.
+    pub(super) fn create(
+        dir: &Path,
+        input_topics: &[(String, String)],
+        pose_source: PoseSource,
+        world: &str,
+        frame_prefix: &str,
+        view: bool,
+    ) -> Result<OutputBag> {
         let mut bag = BagWriter::create(dir)?;
         let collisions = bag.add_topic("/collisions", COLLISION_REPORT_TYPE, false)?;
         let topics = if view {
@@ -130,7 +138,8 @@ impl OutputBag {
         let (jobs, queue) = sync_channel(QUEUE);
         // Room for every batch there can be: the writer never waits to hand one back.
         let (done_tx, done) = sync_channel(QUEUE + 2);
-        let writer = Writer { bag, world: world.to_owned(), collisions, topics, robot: None, poses: TfMessage::default() };
+        let writer =
+            Writer { bag, world: world.to_owned(), frame_prefix: frame_prefix.to_owned(), collisions, topics, robot: None, poses: TfMessage::default() };
         let handle =
             std::thread::Builder::new().name("bag writer".into()).spawn(move || writer.run(queue, done_tx)).context("cannot start the bag writer thread")?;
         Ok(OutputBag { jobs: Some(jobs), done, batch: Vec::with_capacity(BATCH), writer: Some(handle), view: state })
@@ -198,11 +207,10 @@ impl OutputBag {
         let mut joints = None;
         let mut robot = None;
         if let Some(view) = self.view.as_mut().filter(|v| !v.copy_tf) {
-            if let Some(q) = pipeline.joint_positions(state) {
+            if let Some(q) = state.joint_positions() {
                 if !view.robot.as_ref().is_some_and(|c| Arc::ptr_eq(c, pipeline.checker())) {
                     view.robot = Some(pipeline.checker().clone());
-                    let params = pipeline.params();
-                    robot = Some(Job::Robot(pipeline.checker().clone(), params.world_frame.clone(), params.frame_prefix.clone()));
+                    robot = Some(Job::Robot(pipeline.checker().clone()));
                 }
                 joints = Some(q.to_vec());
             }
@@ -250,16 +258,16 @@ impl Writer {
                 // Lifetime zero: each report's DELETEALL replaces the one before, however far apart.
                 let markers = contact_markers(&checked.report, &self.world, checked.stamp, DurationMsg::default());
                 self.bag.write_with(t.contacts, |w| w.marker_array(&markers), *log_time)?;
-                if let (Some(q), Some((checker, world, prefix))) = (joints, &self.robot) {
-                    if link_transforms(checker, world, prefix, q, checked.stamp, &mut self.poses) {
+                if let (Some(q), Some(checker)) = (joints, &self.robot) {
+                    if link_transforms(checker, &self.world, &self.frame_prefix, q, checked.stamp, &mut self.poses) {
                         let poses = &self.poses;
                         self.bag.write_with(t.tf, |w| w.tf_message(poses), *log_time)?;
                     }
                 }
                 Ok(())
             }
-            (Job::Robot(checker, world, prefix), _) => {
-                self.robot = Some((checker.clone(), world.clone(), prefix.clone()));
+            (Job::Robot(checker), _) => {
+                self.robot = Some(checker.clone());
                 // Another robot's frame names must not be reused.
                 self.poses = TfMessage::default();
                 Ok(())

@@ -174,7 +174,9 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
         },
         jsonl_path: opts.jsonl.clone(),
         bag: match &opts.out_dir {
-            Some(d) => Some(OutputBag::create(d, bag.topics(), pose_source, &pipeline.params().world_frame, !opts.no_markers)?),
+            Some(d) => {
+                Some(OutputBag::create(d, bag.topics(), pose_source, &pipeline.params().world_frame, &pipeline.params().frame_prefix, !opts.no_markers)?)
+            }
             None => None,
         },
         plot: match &opts.plot {
