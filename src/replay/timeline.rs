@@ -222,7 +222,7 @@ impl TimelineRow {
         let span = self.bars.last().map_or(0.0, |b| b.end) - self.bars.first().map_or(0.0, |b| b.start);
         let mut gap = (span / MAX_BARS_KEPT as f64).max(self.merged_within * 2.0).max(1e-9);
         loop {
-            merge_bars_in_place(&mut self.bars, |a, b| b.start - a.end < gap);
+            merge_bars(&mut self.bars, |a, b| b.start - a.end < gap);
             if self.bars.len() <= MAX_BARS_KEPT / 2 {
                 break;
             }
@@ -232,8 +232,9 @@ impl TimelineRow {
     }
 }
 
-/// [`merge_bars`] within the vector, which keeps its block.
-fn merge_bars_in_place(bars: &mut Vec<TimelineBar>, close: impl Fn(&TimelineBar, &TimelineBar) -> bool) {
+/// Merges each bar into the one before it while `close(before, bar)`, within the vector (which
+/// keeps its block: a row's bars are merged again and again while a bag streams).
+pub fn merge_bars(bars: &mut Vec<TimelineBar>, close: impl Fn(&TimelineBar, &TimelineBar) -> bool) {
     let mut kept = 0;
     for i in 0..bars.len() {
         if kept > 0 && close(&bars[kept - 1], &bars[i]) {
@@ -245,18 +246,6 @@ fn merge_bars_in_place(bars: &mut Vec<TimelineBar>, close: impl Fn(&TimelineBar,
         }
     }
     bars.truncate(kept);
-}
-
-/// Merges each bar into the one before it while `close(before, bar)`.
-pub fn merge_bars(bars: Vec<TimelineBar>, close: impl Fn(&TimelineBar, &TimelineBar) -> bool) -> Vec<TimelineBar> {
-    let mut out: Vec<TimelineBar> = Vec::with_capacity(bars.len());
-    for b in bars {
-        match out.last_mut() {
-            Some(last) if close(last, &b) => last.absorb(&b),
-            _ => out.push(b),
-        }
-    }
-    out
 }
 
 #[cfg(test)]

@@ -103,7 +103,8 @@ fn draw(root: &DrawingArea<SVGBackend, Shift>, t: &Timeline, bag: &str) -> Resul
         let bottom = chart.backend_coord(&(0.0, SegmentValue::Exact(i))).1 - 3;
         let px = |s: f64| chart.backend_coord(&(s, SegmentValue::Exact(i))).0;
         // Bars closer than MERGE_PIXELS on screen are one bar.
-        let bars = merge_bars(row.bars.clone(), |a, b| px(b.start) - px(a.end).max(px(a.start) + MIN_BAR_PIXELS) < MERGE_PIXELS);
+        let mut bars = row.bars.clone();
+        merge_bars(&mut bars, |a, b| px(b.start) - px(a.end).max(px(a.start) + MIN_BAR_PIXELS) < MERGE_PIXELS);
         for b in &bars {
             let x0 = px(b.start);
             let x1 = px(b.end).max(x0 + MIN_BAR_PIXELS);
