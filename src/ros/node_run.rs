@@ -511,8 +511,8 @@ impl NodeState {
             }
         }
         self.warn_pending();
-        let shared = good.len().saturating_sub(SEPARATE_REPORTS - 1).max(good.len().min(1));
-        let (older, newest) = good.split_at(shared);
+        // Past SEPARATE_REPORTS waiting, the oldest beyond the newest SEPARATE_REPORTS - 1 share one.
+        let (older, newest) = good.split_at(good.len().saturating_sub(SEPARATE_REPORTS - 1));
         if !older.is_empty() {
             self.publish_report(io, older).await;
         }
