@@ -6,7 +6,7 @@
 use super::checker_build::Checker;
 use super::motion::{grow, MotionBounds, MotionReport, MAX_SUBINTERVALS};
 use super::state_report::{ObjectType, ReportContact, StateReport};
-use crate::collision::{collide_pair, CollideSettings, PairContact, Target, TargetShape};
+use crate::collision::{collide_pair, pair_may_meet, CollideSettings, PairContact, Target, TargetShape};
 use crate::math::{Pose, Real};
 use std::collections::hash_map::{Entry, HashMap};
 
@@ -163,7 +163,7 @@ impl Checker {
                     };
                     let (delta_a, delta_b) = path.pair_bound(ta, tb, poses, half);
                     let ((level_a, tested_a), (level_b, tested_b)) = (rung(bounds, delta_a), rung(bounds, delta_b));
-                    Ok(if tested_a && tested_b && self.grown_pair_contact(ta, level_a, &pa, tb, level_b, &pb).is_none() {
+                    Ok(if tested_a && tested_b && !self.grown_pair_may_meet(ta, level_a, &pa, tb, level_b, &pb) {
                         Stretch::Clear
                     } else if level_a.is_none_or(|l| l == 0) && level_b.is_none_or(|l| l == 0) {
                         Stretch::Blocked(Blocked { fraction: a, ti: ta, level: level_a, pose: pa, other: Some((tb, level_b, pb)) })
@@ -210,6 +210,19 @@ impl Checker {
         self.targets()[ti].parts.iter().enumerate().any(|(pi, (_, offset))| {
             let target = Target::new(self.grown_part(ti, pi, level).clone(), *link_pose * *offset);
             !self.collide_target(ti, &target, settings).contacts.is_empty()
+        })
+    }
+
+    /// Whether any part of target `ta` may meet any of `tb`, each grown by its ladder level, at
+    /// the given link poses (see [`pair_may_meet`]).
+    fn grown_pair_may_meet(&self, ta: usize, level_a: Option<usize>, pa: &Pose, tb: usize, level_b: Option<usize>, pb: &Pose) -> bool {
+        self.targets()[ta].parts.iter().enumerate().any(|(ia, (_, oa))| {
+            let part_a = Target::new(self.grown_part(ta, ia, level_a).clone(), *pa * *oa);
+            self.targets()[tb]
+                .parts
+                .iter()
+                .enumerate()
+                .any(|(ib, (_, ob))| pair_may_meet(&part_a, &Target::new(self.grown_part(tb, ib, level_b).clone(), *pb * *ob)))
         })
     }
 

@@ -35,6 +35,22 @@ impl TargetShape {
 
 /// Whether two posed parts overlap, and how deep; touching counts as apart.
 pub fn collide_pair(a: &Target, b: &Target) -> Option<PairContact> {
+    match verdict(a, b)? {
+        Verdict::Apart(_) => None,
+        Verdict::Overlap | Verdict::Unknown => depth(a, b),
+    }
+}
+
+/// Whether two posed parts may meet: `false` only with a proof (their bounding balls apart, or a
+/// separating axis). A motion's stretch is cleared on this alone: the depth (EPA) of a pair that
+/// overlaps cost 24 µs a test on the motion benchmark, the whole answer only ~1 µs.
+pub fn pair_may_meet(a: &Target, b: &Target) -> bool {
+    !matches!(verdict(a, b), None | Some(Verdict::Apart(_)))
+}
+
+/// The proof-carrying GJK's verdict on two posed parts; `None` when their bounding balls are
+/// apart.
+fn verdict(a: &Target, b: &Target) -> Option<Verdict> {
     let (ca, cb) = (a.pose * a.shape.centre(), b.pose * b.shape.centre());
     let reach = a.shape.bounding_radius() + b.shape.bounding_radius();
     if !((ca - cb).length_squared() < reach * reach) {
@@ -46,10 +62,7 @@ pub fn collide_pair(a: &Target, b: &Target) -> Option<PairContact> {
         let pb = b.pose * b.shape.support_point(rb * -d);
         (pa - pb, d.dot(pa), d.dot(pb))
     };
-    match convex_pair(support, cb - ca) {
-        Verdict::Apart(_) => None,
-        Verdict::Overlap | Verdict::Unknown => depth(a, b),
-    }
+    Some(convex_pair(support, cb - ca))
 }
 
 /// parry's contact query (GJK, then EPA) for a pair that may overlap.

@@ -162,16 +162,33 @@ impl Scene {
             let mut recent = RecentAxes::default();
             let mut hit_object = false;
             if settings.flag_only || settings.all_contacts {
-                // Every cell that can meet the target, depth first through the tree.
-                let mut stack = vec![0u32];
+                // Every cell that can meet the target, depth first through the tree, the child
+                // nearer the target's centre first: a yes/no question ends at the first cell that
+                // collides, most likely under the target (on the motion benchmark, where most
+                // such questions are asked, a test that hit cost ~24 µs walking the tree left
+                // first).
+                let mut stack: Vec<u32> = Vec::with_capacity(64);
+                if tree.bound(0, &view).is_some() {
+                    stack.push(0);
+                }
                 while let Some(node) = stack.pop() {
-                    if tree.bound(node, &view).is_none() {
-                        continue;
-                    }
-                    if let Some([left, right]) = tree.children(node) {
-                        tree.prefetch(left);
-                        tree.prefetch(right);
-                        stack.extend([right, left]);
+                    if let Some(children) = tree.children(node) {
+                        let boxes = children.map(|child| tree.node_box(child));
+                        let keep = boxes.map(|(centre, half)| !recent.separate_box(centre, half));
+                        let [a, b] = tree.bounds(children, keep, &view);
+                        let mut next = [(Real::NEG_INFINITY, 0u32); 2];
+                        let mut n = 0;
+                        for ((child, bound), (centre, _)) in children.into_iter().zip([a, b]).zip(boxes) {
+                            if bound.is_some() {
+                                tree.prefetch(child);
+                                next[n] = (-(centre - view.centre).length_squared(), child);
+                                n += 1;
+                            }
+                        }
+                        if n == 2 && next[0].0 > next[1].0 {
+                            next.swap(0, 1);
+                        }
+                        stack.extend(next.into_iter().take(n).map(|(_, child)| child));
                         continue;
                     }
                     for (index, slab) in tree.leaf_cells(node) {
