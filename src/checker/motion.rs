@@ -98,11 +98,7 @@ pub(super) fn grow(shape: &TargetShape, pad: Real) -> TargetShape {
         TargetShape::Capsule { half_height, radius } => TargetShape::Capsule { half_height: *half_height, radius: radius + pad },
         TargetShape::Cylinder { half_height, radius } => TargetShape::Cylinder { half_height: half_height + pad, radius: radius + pad },
         TargetShape::Polytope(h) => {
-            let corners =
-                (0..8).map(|i| Vector::new(if i & 1 == 0 { -pad } else { pad }, if i & 2 == 0 { -pad } else { pad }, if i & 4 == 0 { -pad } else { pad }));
-            let corners: Vec<Vector> = corners.collect();
-            let points: Vec<Vector> = h.points().iter().flat_map(|p| corners.iter().map(move |c| *p + *c)).collect();
-            match ConvexHull::from_points(&points) {
+            match ConvexHull::grown_by_cube(h, pad) {
                 Some(g) => TargetShape::Polytope(Arc::new(g)),
                 // A ball around the hull contains it grown as well.
                 None => TargetShape::Sphere { radius: h.points().iter().map(|p| p.length()).fold(0.0, Real::max) + pad * 3f64.sqrt() },

@@ -47,6 +47,12 @@ pub struct ConvexHull {
     /// or more has no map and climbs from vertex 0.
     starts: Vec<u16>,
     parry: ConvexPolyhedron,
+    /// For a hull grown by a cube ([`ConvexHull::grown_by_cube`]): the hull it grew from and the
+    /// cube's half-side. Its extremes are that hull's plus the cube's (a Minkowski sum's support
+    /// is the sum of the supports), read from the smaller hull's cube map: one map per part stays
+    /// in cache, where each growth's own map (49 kB, a motion tests a part at a dozen growths)
+    /// missed it. The grown hull keeps its own faces and edges for the separating-axis test.
+    grown: Option<(Arc<ConvexHull>, Real)>,
 }
 
 /// Below this many vertices a linear scan beats hill climbing.
@@ -208,11 +214,25 @@ impl ConvexHull {
             adjacency_first[i + 1] = adjacency.len() as u32;
         }
         let radius = points.iter().map(|p| (*p - centroid).length()).fold(0.0, Real::max);
-        let mut hull = ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), adjacency_first, adjacency, starts: Vec::new(), parry };
+        let mut hull =
+            ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), adjacency_first, adjacency, starts: Vec::new(), parry, grown: None };
         if hull.points.len() >= CLIMB_MIN_POINTS && hull.points.len() < EXACT as usize {
             hull.starts = support_cube_map(&hull);
         }
         Some(hull)
+    }
+
+    /// The Minkowski sum of `core` and the cube `[-pad, pad]³` (which holds the ball of radius
+    /// `pad`): every vertex moved to each corner, hulled again.
+    pub(crate) fn grown_by_cube(core: &Arc<ConvexHull>, pad: Real) -> Option<ConvexHull> {
+        let corners =
+            (0..8).map(|i| Vector::new(if i & 1 == 0 { -pad } else { pad }, if i & 2 == 0 { -pad } else { pad }, if i & 4 == 0 { -pad } else { pad }));
+        let corners: Vec<Vector> = corners.collect();
+        let points: Vec<Vector> = core.points.iter().flat_map(|p| corners.iter().map(move |c| *p + *c)).collect();
+        let mut grown = Self::from_points(&points)?;
+        grown.starts = Vec::new();
+        grown.grown = Some((core.clone(), pad));
+        Some(grown)
     }
 
     /// The hull grown by `padding` metres: every vertex moved out along the normal of each of its
@@ -282,7 +302,20 @@ impl ConvexHull {
     /// the vertex extreme at the bin's centre, a step or two away (on a convex polytope a vertex
     /// no neighbour improves on is the global maximum).
     fn climb(&self, dir: Vector) -> Real {
+        if let Some((core, pad)) = &self.grown {
+            return core.extreme(dir) + pad * (dir.x.abs() + dir.y.abs() + dir.z.abs());
+        }
         self.climb_vertex(dir).0
+    }
+
+    /// `max dir . x`, by climbing or, on a small hull, a scan.
+    #[inline]
+    fn extreme(&self, dir: Vector) -> Real {
+        if self.points.len() >= CLIMB_MIN_POINTS {
+            self.climb(dir)
+        } else {
+            crate::math::project_points(&self.points, dir)[1]
+        }
     }
 
     /// [`ConvexHull::climb`] and the vertex it ends at.
@@ -337,6 +370,19 @@ impl ConvexHull {
     /// before any is used, so that the memory waits of the run overlap.
     #[inline]
     fn climb_many(&self, dirs: &[Vector], out: &mut [Real]) {
+        if let Some((core, pad)) = &self.grown {
+            if core.points.len() >= CLIMB_MIN_POINTS {
+                core.climb_many(dirs, out);
+            } else {
+                for (o, d) in out.iter_mut().zip(dirs) {
+                    *o = core.extreme(*d);
+                }
+            }
+            for (o, d) in out.iter_mut().zip(dirs) {
+                *o += pad * (d.x.abs() + d.y.abs() + d.z.abs());
+            }
+            return;
+        }
         let mut entries = [0u16; MANY];
         for (e, d) in entries.iter_mut().zip(dirs) {
             *e = self.entry(*d);
@@ -349,6 +395,9 @@ impl ConvexHull {
     /// A vertex extreme along `dir`.
     #[inline]
     pub(crate) fn support_point(&self, dir: Vector) -> Vector {
+        if let Some((core, pad)) = &self.grown {
+            return core.support_point(dir) + Vector::new(pad.copysign(dir.x), pad.copysign(dir.y), pad.copysign(dir.z));
+        }
         if self.points.len() >= CLIMB_MIN_POINTS {
             return self.points[self.climb_vertex(dir).1];
         }
@@ -532,5 +581,42 @@ impl Target {
             hi[k] = b;
         }
         Aabb::new(lo + pos.translation, hi + pos.translation)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grown hull answers its extremes from the hull it grew from: over random hulls, growths
+    /// and directions, every answer equals the maximum over the grown hull's own vertices.
+    #[test]
+    fn a_grown_hull_has_the_extremes_of_its_own_vertices() {
+        let mut rng = oorandom::Rand64::new(5);
+        let mut unit = || 2.0 * rng.rand_float() - 1.0;
+        let mut checked = 0;
+        for case in 0..60 {
+            // Small hulls are scanned, large ones climbed: both sides of `CLIMB_MIN_POINTS`.
+            let n = if case % 2 == 0 { 10 } else { 200 };
+            let points: Vec<Vector> = (0..n).map(|_| Vector::new(unit() * 0.3, unit() * 0.1, unit() * 0.05)).collect();
+            let core = Arc::new(ConvexHull::from_points(&points).unwrap());
+            let pad = [0.0005, 0.02, 0.3][case % 3];
+            let grown = ConvexHull::grown_by_cube(&core, pad).unwrap();
+            assert!(grown.grown.is_some());
+            let dirs: Vec<Vector> = (0..MANY).map(|_| Vector::new(unit(), unit(), unit())).collect();
+            let mut many = [0.0; MANY];
+            TargetShape::Polytope(Arc::new(grown.clone())).support_many(&dirs, &mut many);
+            for (d, m) in dirs.iter().zip(many) {
+                let own = grown.points.iter().map(|p| d.dot(*p)).fold(Real::NEG_INFINITY, Real::max);
+                let tol = 1e-12 * (1.0 + own.abs());
+                assert!((grown.project(*d)[1] - own).abs() < tol, "project {d:?}");
+                assert!((d.dot(grown.support_point(*d)) - own).abs() < tol, "support_point {d:?}");
+                assert!((m - own).abs() < tol, "support_many {d:?}: {m} against {own}");
+                let low = grown.points.iter().map(|p| d.dot(*p)).fold(Real::INFINITY, Real::min);
+                assert!((grown.project(*d)[0] - low).abs() < tol, "project's low end {d:?}");
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 60 * MANY);
     }
 }
