@@ -59,7 +59,7 @@ pub(crate) struct MotionBounds {
     pub(super) reach: Vec<Real>,
     /// Per target: a point fixed to its link (link frame) and the farthest any of the target's
     /// points lies from it, for the first-order bound of `JointPath::bound`.
-    ball: Vec<(Vector, Real)>,
+    pub(super) ball: Vec<(Vector, Real)>,
     /// Per target, per part, per level: the part grown by `base · 2^level`.
     pub(super) grown: Vec<Vec<Vec<OnceLock<TargetShape>>>>,
     /// Growth of level 0: half the tolerance, so a level under the tolerance exists.

@@ -162,6 +162,12 @@ impl Checker {
                         return Err(format!("no pose for link '{}' or '{}'", la.name, lb.name));
                     };
                     let (delta_a, delta_b) = path.pair_bound(ta, tb, poses, half);
+                    // Balls that hold the two links, each grown by its bound, apart: the pair
+                    // stays apart all along the stretch, at any growth (no hull test needed).
+                    let ((ca, ra), (cb, rb)) = (bounds.ball[ta], bounds.ball[tb]);
+                    if (pa * ca - pb * cb).length() > ra + rb + delta_a + delta_b {
+                        return Ok(Stretch::Clear);
+                    }
                     let ((level_a, tested_a), (level_b, tested_b)) = (rung(bounds, delta_a), rung(bounds, delta_b));
                     Ok(if tested_a && tested_b && !self.grown_pair_may_meet(ta, level_a, &pa, tb, level_b, &pb) {
                         Stretch::Clear
