@@ -283,17 +283,22 @@ impl MotionPath for JointPath<'_> {
     /// and not the other count (a joint above both turns the pair as one body). Each with its
     /// lever bound over all configurations; the world bounds when those are smaller in sum.
     fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], half: f64) -> (Real, Real) {
-        let levers = &self.checker.motion_bounds().levers;
-        let own = |x: usize, y: usize| -> Real {
-            levers[x].iter().filter(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).map(|(j, r)| self.delta[*j].abs() * r).sum()
-        };
-        let relative = (half * own(a, b), half * own(b, a));
+        let relative = self.pair_bound_quick(a, b, poses, half);
         let world = (self.bound(a, poses, half), self.bound(b, poses, half));
         if relative.0 + relative.1 <= world.0 + world.1 {
             relative
         } else {
             world
         }
+    }
+
+    /// The relative bounds of [`JointPath::pair_bound`] alone.
+    fn pair_bound_quick(&self, a: usize, b: usize, _poses: &[Option<Pose>], half: f64) -> (Real, Real) {
+        let levers = &self.checker.motion_bounds().levers;
+        let own = |x: usize, y: usize| -> Real {
+            levers[x].iter().filter(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).map(|(j, r)| self.delta[*j].abs() * r).sum()
+        };
+        (half * own(a, b), half * own(b, a))
     }
 }
 
