@@ -379,6 +379,15 @@ fn a_state_the_node_falls_behind_on_is_still_covered_by_the_next_report() {
         // in transport is covered by nothing, and the test could not tell.
         let sent = (2 + CS) * ROUNDS;
         assert!(received > sent as u64, "check_motion {motion}: the node received {received} states of {}", 1 + sent);
+        // Every state received is counted checked or skipped: a report shared by states that
+        // waited together counts each of them (all checked with motions; without, all but the
+        // newest skipped as stale).
+        let count = |key: &str| -> u64 { answer["diagnostics"][key].as_str().and_then(|s| s.parse().ok()).unwrap_or(u64::MAX / 4) };
+        let (checked, skipped) = (count("states_checked"), count("states_skipped"));
+        assert_eq!(checked + skipped, received, "check_motion {motion}: {}", answer["diagnostics"]);
+        if motion {
+            assert_eq!(skipped, 0, "check_motion {motion}: {}", answer["diagnostics"]);
+        }
         let mut skipped_b = 0;
         for (round, &tb) in b_stamps.iter().enumerate() {
             let first = reports.iter().find(|r| r["stamp"].as_i64().is_some_and(|s| s >= tb));

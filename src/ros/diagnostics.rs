@@ -25,9 +25,10 @@ pub struct NodeStats {
 }
 
 impl NodeStats {
-    /// Counts one checked state that took `seconds`.
-    pub fn record_check(&mut self, seconds: f64) {
-        self.checked += 1;
+    /// Counts one check that took `seconds` and covered `states` states (a motion report covers
+    /// every state that waited for it).
+    pub fn record_check(&mut self, seconds: f64, states: u64) {
+        self.checked += states;
         self.window_checks += 1;
         self.check_sum += seconds;
         self.check_max = self.check_max.max(seconds);

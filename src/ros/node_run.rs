@@ -471,8 +471,13 @@ impl NodeState {
     }
 
     async fn publish_report(&mut self, io: &Interfaces, states: &[RobotState]) {
+        // A report covers every state it was given but those the pipeline counted as skipped
+        // (without `check_motion`, all but the newest): those are the states it checked.
+        let skipped = |p: &Pipeline| p.skipped().values().sum::<u64>();
+        let skipped_before = skipped(&self.pipeline);
         let Some(checked) = self.pipeline.check_path(states) else { return };
-        self.stats.record_check(checked.report.check_seconds);
+        let covered = (states.len() as u64).saturating_sub(skipped(&self.pipeline) - skipped_before);
+        self.stats.record_check(checked.report.check_seconds, covered);
         let world = self.world();
         if io.collisions.async_publish(checked.message(&world)).await.is_err() {
             self.log.warn("publish", || format!("publishing on {} failed", io.names.collisions));
