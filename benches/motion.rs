@@ -10,9 +10,10 @@
 //! `motion_tolerance` at the fastest-moving point, with the 1.2 m lever bound of the Panda, every
 //! link grown by half the tolerance, each sample a flags-only check); and on the first `COAL`
 //! motions (default 1,000; 0 skips), beside coal with MoveIt-style sampling (201 states per
-//! motion, `benches/coal_motion.py`), with the count of motions that sampling passes but that
-//! collide: reported colliding by `check_motion` and confirmed by dense sampling from the
-//! reported fraction on.
+//! motion, `benches/coal_motion.py`, the environment only), with the count of motions that
+//! sampling passes but that collide with the environment: reported colliding by `check_motion`
+//! and confirmed by dense sampling from the reported fraction on (those where the arm meets
+//! itself first are counted apart).
 
 #[path = "peer_compare_core.rs"]
 mod peer_compare_core;
