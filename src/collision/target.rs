@@ -132,13 +132,24 @@ fn support_cube_map(hull: &ConvexHull) -> Vec<u16> {
     starts
 }
 
+/// The corners of the box `[-h, h]`: corner `i` has x, y, z positive where bits 0, 1, 2 of `i`
+/// are set.
+fn cube_corners(h: Vector) -> [Vector; 8] {
+    std::array::from_fn(|i| Vector::new(if i & 1 == 0 { -h.x } else { h.x }, if i & 2 == 0 { -h.y } else { h.y }, if i & 4 == 0 { -h.z } else { h.z }))
+}
+
 impl ConvexHull {
     /// The convex hull of `points` (at least 4 points not in one plane), with coplanar faces merged.
     pub fn from_points(points: &[Vector]) -> Option<ConvexHull> {
+        Self::hull_of(points, true)
+    }
+
+    /// [`ConvexHull::from_points`], with the cube map of climb starts or without it.
+    fn hull_of(points: &[Vector], cube_map: bool) -> Option<ConvexHull> {
         if points.len() < 4 || points.iter().any(|p| !p.is_finite()) {
             return None;
         }
-        Self::from_parry(ConvexPolyhedron::from_convex_hull(points)?)
+        Self::from_parry(ConvexPolyhedron::from_convex_hull(points)?, cube_map)
     }
 
     /// An axis-aligned box `[-half, half]`. Its faces are given, not found: parry's hull
@@ -148,16 +159,13 @@ impl ConvexHull {
         if !(h.min_element() > 0.0) || !h.is_finite() {
             return None;
         }
-        // Corner i has x, y, z positive where bits 0, 1, 2 of i are set.
-        let corners: Vec<Vector> = (0..8)
-            .map(|i| Vector::new(if i & 1 == 0 { -h.x } else { h.x }, if i & 2 == 0 { -h.y } else { h.y }, if i & 4 == 0 { -h.z } else { h.z }))
-            .collect();
+        let corners = cube_corners(h).to_vec();
         const FACES: [[u32; 3]; 12] =
             [[0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5], [0, 1, 5], [0, 5, 4], [2, 6, 7], [2, 7, 3], [0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6]];
-        Self::from_parry(ConvexPolyhedron::from_convex_mesh(corners, &FACES)?)
+        Self::from_parry(ConvexPolyhedron::from_convex_mesh(corners, &FACES)?, true)
     }
 
-    fn from_parry(parry: ConvexPolyhedron) -> Option<ConvexHull> {
+    fn from_parry(parry: ConvexPolyhedron, cube_map: bool) -> Option<ConvexHull> {
         let points = parry.points().to_vec();
         let (lo, hi) = points.iter().fold((Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
         let centroid = points.iter().copied().sum::<Vector>() / points.len() as Real;
@@ -216,21 +224,19 @@ impl ConvexHull {
         let radius = points.iter().map(|p| (*p - centroid).length()).fold(0.0, Real::max);
         let mut hull =
             ConvexHull { points, faces, edges, centroid, radius, aabb: Aabb::new(lo, hi), adjacency_first, adjacency, starts: Vec::new(), parry, grown: None };
-        if hull.points.len() >= CLIMB_MIN_POINTS && hull.points.len() < EXACT as usize {
+        if cube_map && hull.points.len() >= CLIMB_MIN_POINTS && hull.points.len() < EXACT as usize {
             hull.starts = support_cube_map(&hull);
         }
         Some(hull)
     }
 
     /// The Minkowski sum of `core` and the cube `[-pad, pad]³` (which holds the ball of radius
-    /// `pad`): every vertex moved to each corner, hulled again.
+    /// `pad`): every vertex moved to each corner, hulled again. No cube map of its own: its
+    /// extremes are read from `core`'s.
     pub(crate) fn grown_by_cube(core: &Arc<ConvexHull>, pad: Real) -> Option<ConvexHull> {
-        let corners =
-            (0..8).map(|i| Vector::new(if i & 1 == 0 { -pad } else { pad }, if i & 2 == 0 { -pad } else { pad }, if i & 4 == 0 { -pad } else { pad }));
-        let corners: Vec<Vector> = corners.collect();
+        let corners = cube_corners(Vector::splat(pad));
         let points: Vec<Vector> = core.points.iter().flat_map(|p| corners.iter().map(move |c| *p + *c)).collect();
-        let mut grown = Self::from_points(&points)?;
-        grown.starts = Vec::new();
+        let mut grown = Self::hull_of(&points, false)?;
         grown.grown = Some((core.clone(), pad));
         Some(grown)
     }
@@ -318,6 +324,19 @@ impl ConvexHull {
         }
     }
 
+    /// [`ConvexHull::extreme`] for each of `dirs` into `out`, climbed together when there are at
+    /// most [`MANY`].
+    #[inline]
+    fn extremes(&self, dirs: &[Vector], out: &mut [Real]) {
+        if self.points.len() >= CLIMB_MIN_POINTS && dirs.len() <= MANY {
+            self.climb_many(dirs, out);
+        } else {
+            for (o, d) in out.iter_mut().zip(dirs) {
+                *o = self.extreme(*d);
+            }
+        }
+    }
+
     /// [`ConvexHull::climb`] and the vertex it ends at.
     #[inline]
     fn climb_vertex(&self, dir: Vector) -> (Real, usize) {
@@ -371,13 +390,7 @@ impl ConvexHull {
     #[inline]
     fn climb_many(&self, dirs: &[Vector], out: &mut [Real]) {
         if let Some((core, pad)) = &self.grown {
-            if core.points.len() >= CLIMB_MIN_POINTS {
-                core.climb_many(dirs, out);
-            } else {
-                for (o, d) in out.iter_mut().zip(dirs) {
-                    *o = core.extreme(*d);
-                }
-            }
+            core.extremes(dirs, out);
             for (o, d) in out.iter_mut().zip(dirs) {
                 *o += pad * (d.x.abs() + d.y.abs() + d.z.abs());
             }
@@ -463,7 +476,7 @@ impl TargetShape {
     #[inline]
     pub(crate) fn support(&self, dir: Vector) -> Real {
         match self {
-            TargetShape::Polytope(h) if h.points.len() >= CLIMB_MIN_POINTS => h.climb(dir),
+            TargetShape::Polytope(h) => h.extreme(dir),
             _ => self.project(dir)[1],
         }
     }
@@ -474,7 +487,7 @@ impl TargetShape {
     #[inline]
     pub(crate) fn support_many(&self, dirs: &[Vector], out: &mut [Real]) {
         match self {
-            TargetShape::Polytope(h) if h.points.len() >= CLIMB_MIN_POINTS && dirs.len() <= MANY => h.climb_many(dirs, out),
+            TargetShape::Polytope(h) => h.extremes(dirs, out),
             _ => {
                 for (d, o) in dirs.iter().zip(out) {
                     *o = self.support(*d);
