@@ -9,7 +9,7 @@ use super::diagnostics::{diagnostics, NodeStats};
 use super::discovery_range::DiscoverySettings;
 use super::memory_return::{self, MemoryReturn};
 use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
-use super::param_services::{ros_mapping, ParamRequest, ParamRequests, ParamServers};
+use super::param_services::{ros_mapping, ParamRequest, ParamServers};
 use super::param_values::{declarations, to_json, READ_ONLY};
 use super::ros_args::RosArgs;
 use super::validity_worker::{ValidityWorker, MAX_VALIDITY_PENDING};
@@ -20,7 +20,7 @@ use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
 use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause, TrajectoryJob};
 use anyhow::{anyhow, Context as _, Result};
-use futures::stream::FusedStream;
+use futures::stream::Stream;
 use futures::StreamExt;
 use ros2_client::dds::rustdds::{DomainParticipant, DomainParticipantBuilder};
 use ros2_client::qos::{History, WhenFull};
@@ -290,7 +290,8 @@ fn parameter_options(params: &Params, changes: smol::channel::Sender<Params>) ->
 
 /// What one turn of the loop got.
 enum Event {
-    States(JointState),
+    /// The joint states that were waiting, oldest first (at most [`MAX_STATES_PER_TURN`]).
+    States(Vec<ros2_client::ReadResult<(JointState, MessageInfo)>>),
     Tf(TfMessage),
     TfStatic(TfMessage),
     Description(DescriptionMsg),
@@ -364,6 +365,22 @@ const SEPARATE_REPORTS: usize = 64;
 
 /// The loop's housekeeping period (`/rosout`, `/diagnostics`, the summary for a forced stop).
 const TICK: Duration = Duration::from_millis(100);
+
+/// A tick every `period` from a thread of its own; a tick the loop has not taken yet is not
+/// doubled. The thread ends at the first tick after the loop drops the receiver.
+fn ticks(period: Duration) -> Result<smol::channel::Receiver<()>> {
+    let (tx, rx) = smol::channel::bounded(1);
+    let _ = std::thread::Builder::new()
+        .name("tick".into())
+        .spawn(move || loop {
+            std::thread::sleep(period);
+            if let Err(smol::channel::TrySendError::Closed(())) = tx.try_send(()) {
+                break;
+            }
+        })
+        .context("cannot start the tick thread")?;
+    Ok(rx)
+}
 
 /// How long a stop request waits for the loop (busy building a robot, say) before the process
 /// exits without it: SIGTERM is honoured within 2 s whatever the loop is doing. (Exiting is not
@@ -498,12 +515,11 @@ impl NodeState {
     /// get a report each; one report covers all older ones (the polyline through them with
     /// `check_motion`, else the newest of them, the others stale). A waiting sample that does not
     /// decode is counted and skipped.
-    async fn on_joint_states(&mut self, io: &Interfaces, first: JointState) {
-        let mut batch = vec![first];
-        while batch.len() < MAX_STATES_PER_TURN {
-            match io.states.take() {
-                Ok(Some((m, _))) => batch.push(m),
-                Ok(None) => break,
+    async fn on_joint_states(&mut self, io: &Interfaces, waiting: Vec<ros2_client::ReadResult<(JointState, MessageInfo)>>) {
+        let mut batch = Vec::with_capacity(waiting.len());
+        for m in waiting {
+            match m {
+                Ok((m, _)) => batch.push(m),
                 Err(e) => self.on_read_failed("joint_states", &e),
             }
         }
@@ -808,54 +824,63 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         memory: MemoryReturn::new(),
     };
 
+    let tick_events = ticks(TICK)?;
     smol::block_on(async {
         let spin = smol::spawn(spinner.spin());
         state.publish_cells(&io);
-        type Stream<'a, M> = Pin<Box<dyn FusedStream<Item = ros2_client::ReadResult<(M, MessageInfo)>> + 'a>>;
-        fn stream_of<'a, M: 'static + serde::de::DeserializeOwned>(s: Option<&'a ros2_client::Subscription<M>>) -> Stream<'a, M> {
-            match s {
-                Some(s) => Box::pin(s.async_stream()),
-                None => Box::pin(futures::stream::pending()),
-            }
+        // Every input as one stream of events. `select_all` polls only the sources that woke it
+        // (issue 14): a `select!` over the thirteen polled all of them on every turn, and each
+        // poll of an idle DDS reader takes its cache twice and stores a waker.
+        type Events<'a> = Pin<Box<dyn Stream<Item = Event> + 'a>>;
+        fn read<'a, M: 'static + serde::de::DeserializeOwned>(
+            s: Option<&'a ros2_client::Subscription<M>>,
+            what: &'static str,
+            event: fn(M) -> Event,
+        ) -> Option<Events<'a>> {
+            s.map(|s| -> Events<'a> { Box::pin(s.async_stream().map(move |m| m.map_or_else(|e| Event::ReadFailed(what, e), |(m, _)| event(m)))) })
         }
         let use_tf = io.tf.is_some();
-        let mut states: Stream<JointState> = stream_of((!use_tf).then_some(&io.states));
-        let mut tfs: Stream<TfMessage> = stream_of(io.tf.as_ref().map(|t| &t.0));
-        let mut tf_statics: Stream<TfMessage> = stream_of(io.tf.as_ref().map(|t| &t.1));
-        let mut descriptions: Stream<DescriptionMsg> = stream_of(Some(&io.descriptions));
-        let mut semantics: Stream<DescriptionMsg> = stream_of(Some(&io.semantics));
-        let mut clocks: Stream<ClockMsg> = stream_of(io.clock.as_ref());
-        let mut requests = io.check_states.receive_request_stream();
-        let mut trajectories = io.check_trajectory.receive_request_stream();
-        let mut checked_trajectories = Box::pin(worker.done.clone());
-        let mut validity_requests = io.check_state_validity.receive_request_stream();
-        let mut checked_validity = Box::pin(validity_worker.done.clone());
-        let mut param_requests: ParamRequests = param_servers.as_ref().map_or_else(|| Box::pin(futures::stream::pending()), ParamServers::requests);
-        // One timer for the whole run (issue 14): a fresh smol Timer per turn was registered with
-        // the reactor, and woke it, for every message. The housekeeping (/rosout, /diagnostics,
-        // the summary for a forced stop) runs when the tick has come or is overdue, not per input.
-        let mut tick = smol::Timer::interval(TICK).fuse();
+        let sources: Vec<Option<Events>> = vec![
+            // The joint states waiting together come as one event: the stream is read until it
+            // has nothing more, without the notification drain of `take` (two syscalls a state).
+            (!use_tf).then(|| -> Events { Box::pin(io.states.async_stream().ready_chunks(MAX_STATES_PER_TURN).map(Event::States)) }),
+            read(io.tf.as_ref().map(|t| &t.0), "/tf", Event::Tf),
+            read(io.tf.as_ref().map(|t| &t.1), "/tf_static", Event::TfStatic),
+            read(Some(&io.descriptions), "robot_description", Event::Description),
+            read(Some(&io.semantics), "robot_description_semantic", Event::Semantic),
+            read(io.clock.as_ref(), "/clock", |m: ClockMsg| Event::Clock(m.clock)),
+            Some(Box::pin(
+                io.check_states.receive_request_stream().map(|r| r.map_or_else(|e| Event::ReadFailed("check_states", e), |(id, req)| Event::Request(id, req))),
+            )),
+            Some(Box::pin(
+                io.check_trajectory
+                    .receive_request_stream()
+                    .map(|r| r.map_or_else(|e| Event::ReadFailed("check_trajectory", e), |(id, req)| Event::TrajectoryRequest(id, req))),
+            )),
+            Some(Box::pin(worker.done.clone().map(|(id, answer)| Event::TrajectoryDone(id, answer)))),
+            Some(Box::pin(
+                io.check_state_validity
+                    .receive_request_stream()
+                    .map(|r| r.map_or_else(|e| Event::ReadFailed("check_state_validity", e), |(id, req)| Event::ValidityRequest(id, Box::new(req)))),
+            )),
+            Some(Box::pin(validity_worker.done.clone().map(|(id, answer, reason)| Event::ValidityDone(id, answer, reason)))),
+            param_servers
+                .as_ref()
+                .map(|p| -> Events { Box::pin(p.requests().map(|r| r.map_or_else(|e| Event::ReadFailed("parameter services", e), Event::Parameter))) }),
+            // The tick comes from a thread, not a smol Timer (issue 14): a timer in the reactor
+            // made this thread the one waiting on it, so every state woke it through an eventfd
+            // and re-armed a timerfd (five syscalls a message more than a futex wake).
+            Some(Box::pin(tick_events.map(|()| Event::Tick))),
+        ];
+        let mut events = futures::stream::select_all(sources.into_iter().flatten());
         let (mut tick_due, mut last_tick) = (true, Instant::now());
         while !stop.load(Ordering::SeqCst) {
             if std::mem::take(&mut tick_due) || last_tick.elapsed() >= TICK {
                 last_tick = Instant::now();
                 state.on_tick(&node, &io);
             }
-            let event = futures::select! {
-                m = states.select_next_some() => m.map_or_else(|e| Event::ReadFailed("joint_states", e), |(m, _)| Event::States(m)),
-                m = tfs.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/tf", e), |(m, _)| Event::Tf(m)),
-                m = tf_statics.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/tf_static", e), |(m, _)| Event::TfStatic(m)),
-                m = descriptions.select_next_some() => m.map_or_else(|e| Event::ReadFailed("robot_description", e), |(m, _)| Event::Description(m)),
-                m = semantics.select_next_some() => m.map_or_else(|e| Event::ReadFailed("robot_description_semantic", e), |(m, _)| Event::Semantic(m)),
-                m = clocks.select_next_some() => m.map_or_else(|e| Event::ReadFailed("/clock", e), |(m, _)| Event::Clock(m.clock)),
-                r = requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_states", e), |(id, req)| Event::Request(id, req)),
-                r = trajectories.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_trajectory", e), |(id, req)| Event::TrajectoryRequest(id, req)),
-                (id, answer) = checked_trajectories.select_next_some() => Event::TrajectoryDone(id, answer),
-                r = validity_requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("check_state_validity", e), |(id, req)| Event::ValidityRequest(id, Box::new(req))),
-                (id, answer, reason) = checked_validity.select_next_some() => Event::ValidityDone(id, answer, reason),
-                r = param_requests.select_next_some() => r.map_or_else(|e| Event::ReadFailed("parameter services", e), Event::Parameter),
-                _ = tick.select_next_some() => Event::Tick,
-            };
+            // The tick never ends, so neither does this stream.
+            let Some(event) = events.next().await else { break };
             // A parameter change accepted before this input arrived applies to it.
             state.apply_params(&io, &changes);
             match event {
