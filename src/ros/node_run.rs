@@ -873,6 +873,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
             Some(Box::pin(tick_events.map(|()| Event::Tick))),
         ];
         let mut events = futures::stream::select_all(sources.into_iter().flatten());
+        // The housekeeping (/rosout, /diagnostics, the summary for a forced stop) runs when the
+        // tick has come or is overdue, not per input.
         let (mut tick_due, mut last_tick) = (true, Instant::now());
         while !stop.load(Ordering::SeqCst) {
             if std::mem::take(&mut tick_due) || last_tick.elapsed() >= TICK {
