@@ -177,7 +177,7 @@ impl Timeline {
                 Some(i) => &mut self.rows[i],
                 None => {
                     // Full size at once: the row's bars are never moved to a larger block.
-                    self.rows.push(TimelineRow { link: c.link_name.clone(), bars: Vec::with_capacity(MAX_BARS_KEPT + 1), merged_within: 0.0 });
+                    self.rows.push(TimelineRow { link: c.link_name.clone(), bars: Vec::new(), merged_within: 0.0 });
                     let last = self.rows.len() - 1;
                     &mut self.rows[last]
                 }
