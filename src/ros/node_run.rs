@@ -920,3 +920,22 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     done.store(true, Ordering::SeqCst);
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_come_and_a_missed_one_is_not_doubled() {
+        let rx = ticks(Duration::from_millis(20)).expect("tick thread");
+        let started = Instant::now();
+        for _ in 0..3 {
+            rx.recv_blocking().expect("a tick");
+        }
+        assert!(started.elapsed() >= Duration::from_millis(60), "three ticks of 20 ms in {:?}", started.elapsed());
+        // Ten periods not taken leave one tick waiting, not ten.
+        std::thread::sleep(Duration::from_millis(200));
+        assert!(rx.try_recv().is_ok());
+        assert!(rx.try_recv().is_err());
+    }
+}
