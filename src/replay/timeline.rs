@@ -176,7 +176,7 @@ impl Timeline {
             let row = match self.rows.iter().position(|r| r.link == c.link_name) {
                 Some(i) => &mut self.rows[i],
                 None => {
-                    // Full size at once: the row's bars are never moved to a larger block.
+                    // Grown as bars come (most links collide in a few runs); `MAX_BARS_KEPT` caps it.
                     self.rows.push(TimelineRow { link: c.link_name.clone(), bars: Vec::new(), merged_within: 0.0 });
                     let last = self.rows.len() - 1;
                     &mut self.rows[last]
