@@ -13,6 +13,10 @@
 #   bash benches/run_latency.sh [SECONDS]          # SECONDS per rate, default 10; ~2 minutes after the builds
 #   TC_LATENCY_PIN=1 bash benches/run_latency.sh   # sender on CPU 0, the answerer on CPU 1 (taskset)
 #   TC_LATENCY_ONLY="node cpp" ...                 # a subset of the answerers
+#   TC_LATENCY_ONLY="cpp rust rust-loop node node-loop" ...
+#                                                  # also the Rust relay and the node with
+#                                                  # RUSTDDS_DIRECT_SEND=0: every report sent by
+#                                                  # RustDDS's event loop, as before its change 12
 #   TC_LATENCY_ROUNDS=2 ...                        # repeat the whole set, interleaved
 #
 # Network: every participant binds to 127.0.0.1 (Fast DDS: built-in transports off, one UDPv4
@@ -56,7 +60,9 @@ trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done' EXIT
 start() {  # start WHO DOMAIN: the answerer in the background, its pid in $pid
     case $1 in
         node) ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/thickness_collision run --params-file config/params.yaml > "$out/node-$2.log" 2>&1 & ;;
+        node-loop) RUSTDDS_DIRECT_SEND=0 ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/thickness_collision run --params-file config/params.yaml > "$out/node-loop-$2.log" 2>&1 & ;;
         rust) ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/examples/ros_relay relay > "$out/rust-$2.log" 2>&1 & ;;
+        rust-loop) RUSTDDS_DIRECT_SEND=0 ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/examples/ros_relay relay > "$out/rust-loop-$2.log" 2>&1 & ;;
         cpp) "${pin_answer[@]}" "$peer" relay "$2" > "$out/cpp-$2.log" 2>&1 & ;;
     esac
     pid=$!
@@ -83,7 +89,8 @@ load_after=$(cut -d' ' -f1-3 /proc/loadavg)
 import json, sys, pathlib
 out, rounds, only, seconds, lb, la, network, pin = sys.argv[1:]
 out = pathlib.Path(out)
-names = {"node": "thickness_collision node", "rust": "Rust relay (ros2-client)", "cpp": "C++ relay (Fast DDS)"}
+names = {"node": "thickness_collision node", "rust": "Rust relay (ros2-client)", "cpp": "C++ relay (Fast DDS)",
+         "node-loop": "node, sent by the event loop", "rust-loop": "Rust relay, sent by the event loop"}
 print(f"{seconds} s per rate after 1 s of warm-up; {network}; load average before {lb}, after {la}; "
       f"{'sender on CPU 0, answerer on CPU 1' if pin == '1' else 'not pinned'}\n")
 print("| rate | answerer | round | answered / sent | covered | median (µs) | p99 (µs) | p99.9 (µs) | max (µs) | late sends (> half a period) | check_seconds median / p99 (µs) |")
@@ -97,8 +104,8 @@ for rate in (1000, 10000):
             pc = 100.0 * j["answered"] / j["sent"]
             print(f"| {rate // 1000} kHz | {names[who]} | {r} | {j['answered']:,} / {j['sent']:,} ({pc:.2f} %) | {j['covered']:,} | "
                   + " | ".join(f"{j[k]:.0f}" if j[k] >= 0 else "-" for k in ("median_us", "p99_us", "p999_us", "max_us")) + f" | {j['late_sends']} | "
-                  + (f"{j['check_median_us']:.0f} / {j['check_p99_us']:.0f}" if who == "node" and j["check_median_us"] >= 0 else "-") + " |")
-if "node" in only and "cpp" in only:
+                  + (f"{j['check_median_us']:.0f} / {j['check_p99_us']:.0f}" if who.startswith("node") and j["check_median_us"] >= 0 else "-") + " |")
+if "node" in only.split() and "cpp" in only.split():
     print()
     for r in range(1, int(rounds) + 1):
         n1, c1 = rows[(1000, "node", r)], rows[(1000, "cpp", r)]
@@ -109,13 +116,14 @@ if "node" in only and "cpp" in only:
               f"{n1['p999_us'] - c1['p999_us']:+.0f} µs (goal <= 100), {n1['sent'] - n1['answered']} unanswered (goal 0): "
               f"{'met' if ok1 else 'not met'}; 10 kHz: {100.0 * n10['answered'] / n10['sent']:.2f} % answered (goal >= 99.9), p99 "
               f"{n10['p99_us'] - c10['p99_us']:+.0f} µs (goal <= 50): {'met' if ok10 else 'not met'}")
-if "rust" in only and "cpp" in only:
-    for r in range(1, int(rounds) + 1):
-        for rate in (1000, 10000):
-            a, b = rows[(rate, "rust", r)], rows[(rate, "cpp", r)]
-            print(f"round {r}, {rate // 1000} kHz: Rust relay - C++ relay: median {a['median_us'] - b['median_us']:+.0f} µs, "
-                  f"p99 {a['p99_us'] - b['p99_us']:+.0f} µs, p99.9 {a['p999_us'] - b['p999_us']:+.0f} µs")
+for who in ("rust", "rust-loop", "node-loop"):
+    if who in only.split() and "cpp" in only.split():
+        for r in range(1, int(rounds) + 1):
+            for rate in (1000, 10000):
+                a, b = rows[(rate, who, r)], rows[(rate, "cpp", r)]
+                print(f"round {r}, {rate // 1000} kHz: {names[who]} - C++ relay: median {a['median_us'] - b['median_us']:+.0f} µs, "
+                      f"p99 {a['p99_us'] - b['p99_us']:+.0f} µs, p99.9 {a['p999_us'] - b['p999_us']:+.0f} µs")
 PY
-for f in "$out"/node-*.log; do
+for f in "$out"/node-*.log; do  # node-loop-*.log too
     [ -e "$f" ] && grep -h "shutting down" "$f" | sed 's/^/node: /' || true
 done

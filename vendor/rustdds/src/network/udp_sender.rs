@@ -179,6 +179,12 @@ impl UDPSender {
     }
   }
 
+  /// thickness_collision patch (change 12): a duplicate of the unicast sender socket for a
+  /// DataWriter to send from its own thread (the same open file: non-blocking, same port).
+  pub(crate) fn unicast_socket_clone(&self) -> io::Result<UdpSocket> {
+    self.unicast_socket.try_clone()
+  }
+
   /// All sender sockets, so `DPEventLoop` can arm write readiness on each.
   pub(crate) fn socket_ids(&self) -> Vec<SocketId> {
     let mut v = vec![SocketId::Unicast];

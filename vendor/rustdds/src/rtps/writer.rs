@@ -4,7 +4,7 @@ use std::{
   collections::{BTreeMap, BTreeSet},
   ops::Bound::Included,
   rc::Rc,
-  sync::{atomic, mpsc::TrySendError},
+  sync::{atomic, mpsc::TrySendError, Arc},
 };
 
 #[allow(unused_imports)]
@@ -37,7 +37,7 @@ use crate::{
     rtps_reader_proxy::RtpsReaderProxy,
     timed_event::DpTimerEvent,
     transmit::{DefaultRouteSelector, InterfaceObservations, RouteKey},
-    writer_send_buffer::WriterSendBuffer,
+    writer_send_buffer::{DirectRoute, WriterSendBuffer},
     Message, MessageBuilder,
   },
   structure::{
@@ -135,7 +135,8 @@ pub(crate) struct WriterIngredients {
 
 pub(crate) struct Writer {
   pub endianness: Endianness,
-  pub heartbeat_message_counter: atomic::AtomicI32,
+  // thickness_collision patch (change 12): shared with the direct-send route.
+  pub heartbeat_message_counter: Arc<atomic::AtomicI32>,
   /// Configures the mode in which the
   /// Writer operates. If
   /// pushMode==true, then the Writer
@@ -332,7 +333,7 @@ impl Writer {
 
     Self {
       endianness: Endianness::LittleEndian,
-      heartbeat_message_counter: atomic::AtomicI32::new(1),
+      heartbeat_message_counter: Arc::new(atomic::AtomicI32::new(1)),
       push_mode: true,
       heartbeat_period,
       heartbeat_period_fast,
@@ -781,6 +782,21 @@ impl Writer {
         break;
       }
       let sequence_number = self.last_sent.plus_1();
+
+      // thickness_collision patch (change 12): the DataWriter already sent this sample from its
+      // own thread (`WriterSendBuffer::send_direct_locked`); record it as sent to every reader,
+      // as the push below would have.
+      if sequence_number <= self.send_buffer.direct_through() {
+        if !self.like_stateless {
+          for reader in self.readers.values_mut() {
+            reader.notify_new_cache_change(sequence_number);
+          }
+        }
+        self.last_sent = sequence_number;
+        self.sample_cursor = SampleCursor::Fresh;
+        self.mark_change_sent_to_all_readers(sequence_number);
+        continue;
+      }
 
       // Item 1 (DATA aggregation): coalesce several consecutive small samples
       // into one datagram to amortize the per-sample RTPS header + syscall.
@@ -1964,6 +1980,7 @@ impl Writer {
   /// [`Self::extra_unicast_destinations`].
   pub fn set_extra_unicast_destinations(&mut self, locators: Vec<Locator>) {
     self.extra_unicast_destinations = locators;
+    self.refresh_direct_route();
   }
 
   /// Enable/disable preferring a same-host peer's loopback locator during route
@@ -2132,6 +2149,92 @@ impl Writer {
       .map(RtpsReaderProxy::max_datagram_payload)
       .min()
       .unwrap_or(FALLBACK_MAX_AGGREGATED_DATAGRAM_SIZE);
+    // thickness_collision patch (change 12): every change of the matched readers or their
+    // routes comes through here.
+    self.refresh_direct_route();
+  }
+
+  /// thickness_collision patch (change 12): give the DataWriter a route for sending new
+  /// samples from its own thread, when that route is exactly what `send_message_to_readers`
+  /// would use for a DATA to all readers and every destination is a plain IPv4 unicast
+  /// address; otherwise take it away.
+  fn refresh_direct_route(&mut self) {
+    let route = self.direct_route();
+    self.send_buffer.set_direct_route(route);
+  }
+
+  fn direct_route(&self) -> Option<DirectRoute> {
+    // RUSTDDS_DIRECT_SEND=0 turns direct sends off: the before-and-after of
+    // `benches/run_latency.sh` in one build, and a way back should a network need it.
+    static ENABLED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let enabled =
+      *ENABLED.get_or_init(|| std::env::var("RUSTDDS_DIRECT_SEND").map_or(true, |v| v != "0"));
+    if !enabled
+      || !self.push_mode
+      || self.like_stateless
+      || self.security_plugins.is_some()
+      || self.my_guid.entity_id.kind().is_built_in()
+      || !self.extra_unicast_destinations.is_empty()
+      || self.readers.is_empty()
+    {
+      return None;
+    }
+    let mut destinations: Vec<std::net::SocketAddr> = Vec::new();
+    let mut add = |locator: &Locator| -> Option<()> {
+      let Locator::UdpV4(address) = locator else {
+        return None;
+      };
+      let address = std::net::SocketAddr::from(*address);
+      if address.ip().is_multicast() {
+        return None;
+      }
+      if !destinations.contains(&address) {
+        destinations.push(address);
+      }
+      Some(())
+    };
+    for reader in self.readers.values() {
+      let route = reader.send_route();
+      if route.fallback {
+        // The legacy path sends to every UDP unicast locator unless there is a multicast one.
+        if reader
+          .multicast_locator_list
+          .iter()
+          .any(|l| Locator::is_udp(l))
+        {
+          return None;
+        }
+        let mut any = false;
+        for locator in reader.unicast_locator_list.iter().filter(|l| Locator::is_udp(l)) {
+          add(locator)?;
+          any = true;
+        }
+        if !any {
+          return None;
+        }
+      } else {
+        match (&route.multicast, &route.unicast) {
+          (None, Some(unicast)) => add(unicast)?,
+          _ => return None,
+        }
+      }
+    }
+    let socket = match self.udp_sender.unicast_socket_clone() {
+      Ok(socket) => socket,
+      Err(e) => {
+        debug!("no direct sends for topic {:?}: {e}", self.my_topic_name);
+        return None;
+      }
+    };
+    Some(DirectRoute {
+      socket,
+      destinations,
+      endianness: self.endianness,
+      max_payload: self.max_unfragmented_serialized_payload(None),
+      heartbeat_counter: self
+        .is_reliable()
+        .then(|| Arc::clone(&self.heartbeat_message_counter)),
+    })
   }
 
   /// Refresh the [`SendRoute`](crate::rtps::transmit::SendRoute) of every

@@ -1,7 +1,11 @@
 use std::{
   cmp::max,
   collections::BTreeMap,
-  sync::{Arc, Condvar, Mutex},
+  net::{SocketAddr, UdpSocket},
+  sync::{
+    atomic::{AtomicI32, Ordering},
+    Arc, Condvar, Mutex,
+  },
   time::{Duration as StdDuration, Instant},
 };
 use core::task::Waker;
@@ -9,10 +13,35 @@ use core::task::Waker;
 #[allow(unused_imports)]
 use log::{debug, error, trace, warn};
 
+use speedy::Endianness;
+
 use crate::{
   dds::{ddsdata::DDSData, with_key::datawriter::WriteOptions},
-  structure::{cache_change::CacheChange, guid::GUID, sequence_number::SequenceNumber},
+  rtps::MessageBuilder,
+  structure::{
+    cache_change::CacheChange,
+    guid::{EntityId, GUID},
+    sequence_number::SequenceNumber,
+  },
 };
+
+/// thickness_collision patch (PATCHES.md, change 12): what a `DataWriter` needs to put a new
+/// sample on the wire from its own thread, without waking the event loop first. The Writer
+/// (event loop) sets it whenever its matched readers change, and only when every one of them is
+/// reached by plain IPv4 unicast (no multicast, no security, no extra destinations); otherwise
+/// it is `None` and every sample goes through the event loop as before.
+pub(crate) struct DirectRoute {
+  /// A duplicate of the participant's unicast sender socket (same non-blocking file).
+  pub socket: UdpSocket,
+  /// Every matched reader's destination, deduplicated, as `send_message_to_readers` would
+  /// send a DATA to all readers.
+  pub destinations: Vec<SocketAddr>,
+  pub endianness: Endianness,
+  /// The largest payload sent unfragmented to all readers (the Writer's own bound).
+  pub max_payload: usize,
+  /// The Writer's heartbeat counter, for reliable writers: their DATA carries a HEARTBEAT.
+  pub heartbeat_counter: Option<Arc<AtomicI32>>,
+}
 
 /// Result of an admission attempt into the [`WriterSendBuffer`].
 pub(crate) enum Admission {
@@ -73,6 +102,13 @@ struct Inner {
   // Wakers of async producers / ack-waiters parked because the window was full
   // or acknowledgements were still pending. Drained (woken) on any advance.
   wakers: Vec<Waker>,
+
+  // thickness_collision patch (change 12): the route for sending from the producer's thread,
+  // and the highest sequence number sent that way. A sample is sent directly only when every
+  // earlier one is already on the wire (`sent_frontier` is just below it), so any sample at
+  // or below `direct_through` that the Writer has not yet passed was sent directly.
+  direct: Option<DirectRoute>,
+  direct_through: SequenceNumber,
 }
 
 struct Shared {
@@ -136,6 +172,8 @@ impl WriterSendBuffer {
           sent_frontier: SequenceNumber::new(0),
           max_retain: max_retain.max(1),
           wakers: Vec::new(),
+          direct: None,
+          direct_through: SequenceNumber::new(0),
         }),
         progress: Condvar::new(),
         writer_guid,
@@ -223,6 +261,7 @@ impl WriterSendBuffer {
     loop {
       if Self::has_room(shared, &inner, may_block) {
         let seq = Self::insert_locked(shared, &mut inner, write_options, data, may_block);
+        Self::send_direct_locked(shared, &mut inner, seq);
         return Admission::Admitted(seq);
       }
       // Window full: wait for an acknowledgement to free up space.
@@ -257,13 +296,9 @@ impl WriterSendBuffer {
     let mut inner = shared.inner.lock().unwrap();
     let may_block = shared.reliable_writer || write_options.best_effort_may_block();
     if Self::has_room(shared, &inner, may_block) {
-      Ok(Self::insert_locked(
-        shared,
-        &mut inner,
-        write_options,
-        data,
-        may_block,
-      ))
+      let seq = Self::insert_locked(shared, &mut inner, write_options, data, may_block);
+      Self::send_direct_locked(shared, &mut inner, seq);
+      Ok(seq)
     } else {
       register_waker(&mut inner.wakers, waker);
       Err((write_options, data))
@@ -318,6 +353,83 @@ impl WriterSendBuffer {
       }
     }
     seq
+  }
+
+  // thickness_collision patch (change 12): send the sample just admitted from this (the
+  // producer's) thread when the Writer has nothing older left to send. Before this every sample
+  // went producer thread -> doorbell -> event-loop thread -> socket: one thread wake-up on the
+  // path of every sample, tens of microseconds at the tail when the scheduler is busy. The
+  // datagram is what the Writer's push would send to all readers (INFO_TS, DATA, and a HEARTBEAT
+  // for a reliable writer). If any destination does not take it, nothing is recorded and the
+  // Writer sends it the usual way (a reader that got it twice drops the duplicate). The caller
+  // still rings the doorbell: the Writer does the readers' bookkeeping for a directly sent
+  // sample, and keeps sample order, since it passes it only in sequence.
+  fn send_direct_locked(shared: &Shared, inner: &mut Inner, seq: SequenceNumber) {
+    let Some(route) = inner.direct.as_ref() else {
+      return;
+    };
+    if shared.is_builtin || inner.sent_frontier.plus_1() != seq {
+      return;
+    }
+    let Some(cc) = inner.changes.get(&seq) else {
+      return;
+    };
+    if cc.write_options.to_single_reader().is_some()
+      || cc.data_value.payload_size() > route.max_payload
+    {
+      return;
+    }
+    let mut builder = MessageBuilder::new();
+    if let Some(ts) = cc.write_options.source_timestamp() {
+      builder = builder.ts_msg(route.endianness, Some(ts));
+    }
+    builder = builder.data_msg(
+      cc,
+      EntityId::UNKNOWN,
+      shared.writer_guid,
+      route.endianness,
+      None,
+    );
+    if let Some(counter) = &route.heartbeat_counter {
+      builder = builder.heartbeat_msg(
+        shared.writer_guid.entity_id,
+        inner.first_seq,
+        inner.last_seq,
+        counter.fetch_add(1, Ordering::SeqCst),
+        route.endianness,
+        EntityId::UNKNOWN,
+        false, // final_flag: readers acknowledge, as after the Writer's own push
+        false, // liveliness_flag
+      );
+    }
+    let buffer = match builder
+      .add_header_and_build(shared.writer_guid.prefix)
+      .write_to_vec_fast(route.endianness)
+    {
+      Ok(buffer) => buffer,
+      Err(e) => {
+        debug!("direct send: serializing failed ({e:?}); the Writer sends it");
+        return;
+      }
+    };
+    for destination in &route.destinations {
+      if let Err(e) = route.socket.send_to(&buffer, destination) {
+        trace!("direct send to {destination} failed ({e}); the Writer sends it");
+        return;
+      }
+    }
+    inner.sent_frontier = seq;
+    inner.direct_through = seq;
+  }
+
+  /// thickness_collision patch (change 12): set or clear the route for direct sends (Writer).
+  pub fn set_direct_route(&self, route: Option<DirectRoute>) {
+    self.shared.inner.lock().unwrap().direct = route;
+  }
+
+  /// thickness_collision patch (change 12): the highest sequence number sent directly.
+  pub fn direct_through(&self) -> SequenceNumber {
+    self.shared.inner.lock().unwrap().direct_through
   }
 
   // --- consumer side (Writer / event loop) ---
