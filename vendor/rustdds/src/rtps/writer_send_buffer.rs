@@ -597,6 +597,96 @@ mod tests {
       .build()
   }
 
+  // thickness_collision patch (change 12): a sample goes out from the admitting thread only
+  // with a route, only when every older sample is on the wire, and only unfragmented; a
+  // datagram the Writer would have sent (RTPS header, the DATA with the payload, a HEARTBEAT).
+  #[test]
+  fn a_sample_is_sent_directly_only_when_nothing_older_is_unsent() {
+    let receiver = UdpSocket::bind("127.0.0.1:0").unwrap();
+    receiver.set_nonblocking(true).unwrap();
+    let sender = UdpSocket::bind("127.0.0.1:0").unwrap();
+    sender.set_nonblocking(true).unwrap();
+    let route = |max_payload| DirectRoute {
+      socket: sender.try_clone().unwrap(),
+      destinations: vec![receiver.local_addr().unwrap()],
+      endianness: Endianness::LittleEndian,
+      max_payload,
+      heartbeat_counter: Some(Arc::new(AtomicI32::new(1))),
+    };
+    let payload = |len| {
+      DDSData::new(SerializedPayload::new(
+        RepresentationIdentifier::CDR_LE,
+        vec![0xAB; len],
+      ))
+    };
+    let admit = |buf: &WriterSendBuffer, len| {
+      matches!(
+        buf.admit_blocking(WriteOptions::default(), payload(len), Some(StdDuration::ZERO)),
+        Admission::Admitted(_)
+      )
+    };
+    let received = || {
+      let mut datagram = [0u8; 2048];
+      // Loopback delivers before send_to returns; a short wait covers a slow scheduler.
+      for _ in 0..200 {
+        match receiver.recv(&mut datagram) {
+          Ok(n) => return Some(datagram[..n].to_vec()),
+          Err(_) => std::thread::sleep(StdDuration::from_millis(1)),
+        }
+      }
+      None
+    };
+    let buf = WriterSendBuffer::new(
+      GUID::GUID_UNKNOWN,
+      "t".to_string(),
+      /* reliable_writer */ true,
+      /* is_builtin */ false,
+      /* volatile */ true,
+      /* keep_last */ true,
+      /* window_limit */ 100,
+      /* backlog_limit */ 100,
+      /* max_retain */ 100,
+    );
+
+    // No route: the Writer sends it.
+    assert!(admit(&buf, 8)); // 1
+    assert_eq!(buf.direct_through(), SequenceNumber::new(0));
+    assert!(received().is_none());
+
+    // A route, but sample 1 is not on the wire yet: 2 waits for the Writer too.
+    buf.set_direct_route(Some(route(1000)));
+    assert!(admit(&buf, 8)); // 2
+    assert_eq!(buf.direct_through(), SequenceNumber::new(0));
+    assert!(received().is_none());
+
+    // The Writer sent 1 and 2: 3 goes out directly, and 4 after it.
+    buf.set_sent_frontier(SequenceNumber::new(2));
+    for sn in [3, 4] {
+      assert!(admit(&buf, 8));
+      assert_eq!(buf.direct_through(), SequenceNumber::new(sn));
+      let datagram = received().expect("a datagram from the admitting thread");
+      assert_eq!(&datagram[..4], b"RTPS");
+      assert!(datagram.windows(8).any(|w| w == [0xAB; 8]), "the payload is in it");
+      assert!(datagram.len() > 4 + 16 + 24 + 8 + 28, "header, DATA and HEARTBEAT");
+    }
+
+    // Too large for one datagram: left to the Writer, which fragments it; nothing after it
+    // goes out directly until the Writer has sent it.
+    assert!(admit(&buf, 2000)); // 5
+    assert!(admit(&buf, 8)); // 6
+    assert_eq!(buf.direct_through(), SequenceNumber::new(4));
+    assert!(received().is_none());
+
+    // A destination that refuses the datagram (an IPv6 address on an IPv4 socket): nothing
+    // recorded, the Writer sends it.
+    buf.set_sent_frontier(SequenceNumber::new(6));
+    let mut refusing = route(1000);
+    refusing.destinations = vec!["[::1]:7400".parse().unwrap()];
+    buf.set_direct_route(Some(refusing));
+    assert!(admit(&buf, 8)); // 7
+    assert_eq!(buf.direct_through(), SequenceNumber::new(4));
+  }
+
   // A matched reliable reader that has not sent an ACKNACK yet reports
   // `all_acked_before == 0`. Sequence numbers start at 1, so that frontier
   // leaves nothing unacknowledged on a fresh writer: the window must still
