@@ -3,6 +3,7 @@ use std::{
   collections::HashMap,
   io,
   net::{IpAddr, SocketAddr, UdpSocket},
+  sync::Arc,
 };
 #[cfg(test)]
 use std::net::Ipv4Addr;
@@ -26,7 +27,8 @@ use crate::{
 
 #[derive(Debug)]
 pub struct UDPSender {
-  unicast_socket: UdpSocket,
+  // thickness_collision patch (change 12): shared with the writers' direct-send routes.
+  unicast_socket: Arc<UdpSocket>,
   // One multicast sender socket per local interface, keyed by the interface it
   // was bound to (its `InterfaceSelector`). This lets us target a single
   // interface instead of sending on all of them.
@@ -157,7 +159,7 @@ impl UDPSender {
     } // end for
 
     let sender = Self {
-      unicast_socket,
+      unicast_socket: Arc::new(unicast_socket),
       multicast_sockets,
       control_queues: RefCell::new(HashMap::new()),
     };
@@ -174,15 +176,15 @@ impl UDPSender {
 
   fn socket_ref(&self, id: SocketId) -> Option<&UdpSocket> {
     match id {
-      SocketId::Unicast => Some(&self.unicast_socket),
+      SocketId::Unicast => Some(&*self.unicast_socket),
       SocketId::Multicast(i) => self.multicast_sockets.get(i).map(|(_, s)| s),
     }
   }
 
-  /// thickness_collision patch (change 12): a duplicate of the unicast sender socket for a
-  /// DataWriter to send from its own thread (the same open file: non-blocking, same port).
-  pub(crate) fn unicast_socket_clone(&self) -> io::Result<UdpSocket> {
-    self.unicast_socket.try_clone()
+  /// thickness_collision patch (change 12): the unicast sender socket, for a DataWriter to send
+  /// from its own thread (non-blocking, the participant's sending port).
+  pub(crate) fn unicast_socket(&self) -> Arc<UdpSocket> {
+    Arc::clone(&self.unicast_socket)
   }
 
   /// All sender sockets, so `DPEventLoop` can arm write readiness on each.

@@ -2205,7 +2205,11 @@ impl Writer {
           return None;
         }
         let mut any = false;
-        for locator in reader.unicast_locator_list.iter().filter(|l| Locator::is_udp(l)) {
+        for locator in reader
+          .unicast_locator_list
+          .iter()
+          .filter(|l| Locator::is_udp(l))
+        {
           add(locator)?;
           any = true;
         }
@@ -2219,15 +2223,8 @@ impl Writer {
         }
       }
     }
-    let socket = match self.udp_sender.unicast_socket_clone() {
-      Ok(socket) => socket,
-      Err(e) => {
-        debug!("no direct sends for topic {:?}: {e}", self.my_topic_name);
-        return None;
-      }
-    };
     Some(DirectRoute {
-      socket,
+      socket: self.udp_sender.unicast_socket(),
       destinations,
       endianness: self.endianness,
       max_payload: self.max_unfragmented_serialized_payload(None),

@@ -31,8 +31,8 @@ use crate::{
 /// reached by plain IPv4 unicast (no multicast, no security, no extra destinations); otherwise
 /// it is `None` and every sample goes through the event loop as before.
 pub(crate) struct DirectRoute {
-  /// A duplicate of the participant's unicast sender socket (same non-blocking file).
-  pub socket: UdpSocket,
+  /// The participant's unicast sender socket (non-blocking), shared with its `UDPSender`.
+  pub socket: Arc<UdpSocket>,
   /// Every matched reader's destination, deduplicated, as `send_message_to_readers` would
   /// send a DATA to all readers.
   pub destinations: Vec<SocketAddr>,
@@ -368,7 +368,8 @@ impl WriterSendBuffer {
     let Some(route) = inner.direct.as_ref() else {
       return;
     };
-    if shared.is_builtin || inner.sent_frontier.plus_1() != seq {
+    // (No route is ever set for a built-in writer: `Writer::direct_route`.)
+    if inner.sent_frontier.plus_1() != seq {
       return;
     }
     let Some(cc) = inner.changes.get(&seq) else {
@@ -607,7 +608,7 @@ mod tests {
     let sender = UdpSocket::bind("127.0.0.1:0").unwrap();
     sender.set_nonblocking(true).unwrap();
     let route = |max_payload| DirectRoute {
-      socket: sender.try_clone().unwrap(),
+      socket: Arc::new(sender.try_clone().unwrap()),
       destinations: vec![receiver.local_addr().unwrap()],
       endianness: Endianness::LittleEndian,
       max_payload,
@@ -621,7 +622,11 @@ mod tests {
     };
     let admit = |buf: &WriterSendBuffer, len| {
       matches!(
-        buf.admit_blocking(WriteOptions::default(), payload(len), Some(StdDuration::ZERO)),
+        buf.admit_blocking(
+          WriteOptions::default(),
+          payload(len),
+          Some(StdDuration::ZERO)
+        ),
         Admission::Admitted(_)
       )
     };
@@ -666,8 +671,14 @@ mod tests {
       assert_eq!(buf.direct_through(), SequenceNumber::new(sn));
       let datagram = received().expect("a datagram from the admitting thread");
       assert_eq!(&datagram[..4], b"RTPS");
-      assert!(datagram.windows(8).any(|w| w == [0xAB; 8]), "the payload is in it");
-      assert!(datagram.len() > 4 + 16 + 24 + 8 + 28, "header, DATA and HEARTBEAT");
+      assert!(
+        datagram.windows(8).any(|w| w == [0xAB; 8]),
+        "the payload is in it"
+      );
+      assert!(
+        datagram.len() > 4 + 16 + 24 + 8 + 28,
+        "header, DATA and HEARTBEAT"
+      );
     }
 
     // Too large for one datagram: left to the Writer, which fragments it; nothing after it
