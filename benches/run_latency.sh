@@ -13,10 +13,14 @@
 #   bash benches/run_latency.sh [SECONDS]          # SECONDS per rate, default 10; ~2 minutes after the builds
 #   TC_LATENCY_PIN=1 bash benches/run_latency.sh   # sender on CPU 0, the answerer on CPU 1 (taskset)
 #   TC_LATENCY_ONLY="node cpp" ...                 # a subset of the answerers
-#   TC_LATENCY_ONLY="cpp rust rust-loop node node-loop" ...
-#                                                  # also the Rust relay and the node with
-#                                                  # RUSTDDS_DIRECT_SEND=0: every report sent by
-#                                                  # RustDDS's event loop, as before its change 12
+#   TC_LATENCY_ONLY="cpp rust rust-loop node node-handover node-loop" ...
+#                                                  # also the node with TC_CHECK_ON_RECEIVE=0
+#                                                  # (each state handed from RustDDS's receiving
+#                                                  # thread to the node's loop, as before
+#                                                  # states_on_receive.rs), and the Rust relay and
+#                                                  # that node with RUSTDDS_DIRECT_SEND=0 too (every
+#                                                  # report sent by RustDDS's event loop, as before
+#                                                  # its change 12)
 #   TC_LATENCY_ROUNDS=2 ...                        # repeat the whole set, interleaved
 #
 # Network: every participant binds to 127.0.0.1 (Fast DDS: built-in transports off, one UDPv4
@@ -60,7 +64,8 @@ trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done' EXIT
 start() {  # start WHO DOMAIN: the answerer in the background, its pid in $pid
     case $1 in
         node) ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/thickness_collision run --params-file config/params.yaml > "$out/node-$2.log" 2>&1 & ;;
-        node-loop) RUSTDDS_DIRECT_SEND=0 ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/thickness_collision run --params-file config/params.yaml > "$out/node-loop-$2.log" 2>&1 & ;;
+        node-handover) TC_CHECK_ON_RECEIVE=0 ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/thickness_collision run --params-file config/params.yaml > "$out/node-handover-$2.log" 2>&1 & ;;
+        node-loop) TC_CHECK_ON_RECEIVE=0 RUSTDDS_DIRECT_SEND=0 ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/thickness_collision run --params-file config/params.yaml > "$out/node-loop-$2.log" 2>&1 & ;;
         rust) ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/examples/ros_relay relay > "$out/rust-$2.log" 2>&1 & ;;
         rust-loop) RUSTDDS_DIRECT_SEND=0 ROS_DOMAIN_ID=$2 "${pin_answer[@]}" target/release/examples/ros_relay relay > "$out/rust-loop-$2.log" 2>&1 & ;;
         cpp) "${pin_answer[@]}" "$peer" relay "$2" > "$out/cpp-$2.log" 2>&1 & ;;
@@ -90,7 +95,8 @@ import json, sys, pathlib
 out, rounds, only, seconds, lb, la, network, pin = sys.argv[1:]
 out = pathlib.Path(out)
 names = {"node": "thickness_collision node", "rust": "Rust relay (ros2-client)", "cpp": "C++ relay (Fast DDS)",
-         "node-loop": "node, sent by the event loop", "rust-loop": "Rust relay, sent by the event loop"}
+         "node-loop": "node, handed over and sent by the event loop",
+         "node-handover": "node, handed over to its loop", "rust-loop": "Rust relay, sent by the event loop"}
 print(f"{seconds} s per rate after 1 s of warm-up; {network}; load average before {lb}, after {la}; "
       f"{'sender on CPU 0, answerer on CPU 1' if pin == '1' else 'not pinned'}\n")
 print("| rate | answerer | round | answered / sent | covered | median (µs) | p99 (µs) | p99.9 (µs) | max (µs) | late sends (> half a period) | check_seconds median / p99 (µs) |")
@@ -116,7 +122,7 @@ if "node" in only.split() and "cpp" in only.split():
               f"{n1['p999_us'] - c1['p999_us']:+.0f} µs (goal <= 100), {n1['sent'] - n1['answered']} unanswered (goal 0): "
               f"{'met' if ok1 else 'not met'}; 10 kHz: {100.0 * n10['answered'] / n10['sent']:.2f} % answered (goal >= 99.9), p99 "
               f"{n10['p99_us'] - c10['p99_us']:+.0f} µs (goal <= 50): {'met' if ok10 else 'not met'}")
-for who in ("rust", "rust-loop", "node-loop"):
+for who in ("rust", "rust-loop", "node-loop", "node-handover"):
     if who in only.split() and "cpp" in only.split():
         for r in range(1, int(rounds) + 1):
             for rate in (1000, 10000):
@@ -124,6 +130,6 @@ for who in ("rust", "rust-loop", "node-loop"):
                 print(f"round {r}, {rate // 1000} kHz: {names[who]} - C++ relay: median {a['median_us'] - b['median_us']:+.0f} µs, "
                       f"p99 {a['p99_us'] - b['p99_us']:+.0f} µs, p99.9 {a['p999_us'] - b['p999_us']:+.0f} µs")
 PY
-for f in "$out"/node-*.log; do  # node-loop-*.log too
-    [ -e "$f" ] && grep -h "shutting down" "$f" | sed 's/^/node: /' || true
+for f in "$out"/node-*.log; do  # node-loop-*.log, node-handover-*.log too
+    [ -e "$f" ] && grep -h "shutting down" "$f" | sed "s/^/$(basename "$f" .log): /" || true
 done

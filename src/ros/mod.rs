@@ -15,6 +15,7 @@ mod node_run;
 mod param_services;
 mod param_values;
 mod ros_args;
+mod states_on_receive;
 mod validity_worker;
 
 pub use self::node_run::{run, RunOptions};

@@ -1,5 +1,7 @@
 //! The node's life: participant, node, topics and services, and the loop that hands every
 //! input to the [`Pipeline`] and publishes what it returns. Nothing here decides an answer.
+//! Joint states are mostly answered before they reach the loop, on the thread that received
+//! them, whenever the loop is not holding the node's state (`states_on_receive.rs`).
 //!
 //! `check_trajectory` requests are resolved by the pipeline on the loop (validation and the
 //! current joint state: no geometry) and checked on a worker thread of their own, so a long
@@ -12,6 +14,7 @@ use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, Descri
 use super::param_services::{ros_mapping, ParamRequest, ParamServers};
 use super::param_values::{declarations, to_json, READ_ONLY};
 use super::ros_args::RosArgs;
+use super::states_on_receive::{Checking, OnReceive};
 use super::validity_worker::{ValidityWorker, MAX_VALIDITY_PENDING};
 use crate::limits::MAX_DESCRIPTION_BYTES;
 use crate::markers::{cell_markers, contact_markers};
@@ -108,8 +111,8 @@ fn ros_name(name: &str, namespace: &str) -> Result<Name> {
 }
 
 /// The node's topics, publishers, subscriptions and service, made once at start.
-struct Interfaces {
-    states: ros2_client::Subscription<JointState>,
+pub(super) struct Interfaces {
+    pub(super) states: ros2_client::Subscription<JointState>,
     tf: Option<(ros2_client::Subscription<TfMessage>, ros2_client::Subscription<TfMessage>)>,
     descriptions: ros2_client::Subscription<DescriptionMsg>,
     semantics: ros2_client::Subscription<DescriptionMsg>,
@@ -290,8 +293,8 @@ fn parameter_options(params: &Params, changes: smol::channel::Sender<Params>) ->
 
 /// What one turn of the loop got.
 enum Event {
-    /// The joint states that were waiting, oldest first (at most [`MAX_STATES_PER_TURN`]).
-    States(Vec<ros2_client::ReadResult<(JointState, MessageInfo)>>),
+    /// Joint states are waiting that the receiving thread left to the loop.
+    States,
     Tf(TfMessage),
     TfStatic(TfMessage),
     Description(DescriptionMsg),
@@ -350,7 +353,7 @@ impl TrajectoryWorker {
 
 /// Joint states taken in one turn of the loop at most: the rest wait for the next turn, so a
 /// flood cannot keep the loop from a stop request or the other inputs.
-const MAX_STATES_PER_TURN: usize = 256;
+pub(super) const MAX_STATES_PER_TURN: usize = 256;
 
 /// Joint states the reader keeps while the node is busy.
 const STATES_KEPT: usize = 100;
@@ -392,7 +395,7 @@ const STOP_GRACE: Duration = Duration::from_millis(1000);
 const CONTACT_MARKER_LIFETIME: crate::msgs::DurationMsg = crate::msgs::DurationMsg { sec: 0, nanosec: 500_000_000 };
 
 /// The node's state between messages.
-struct NodeState {
+pub(super) struct NodeState {
     pipeline: Pipeline,
     stats: NodeStats,
     log: RateLimitedLog,
@@ -487,7 +490,7 @@ impl NodeState {
         }
     }
 
-    async fn publish_report(&mut self, io: &Interfaces, states: &[RobotState]) {
+    fn publish_report(&mut self, io: &Interfaces, states: &[RobotState]) {
         // A report covers every state it was given but those the pipeline counted as skipped
         // (without `check_motion`, all but the newest): those are the states it checked.
         let skipped = |p: &Pipeline| p.skipped().values().sum::<u64>();
@@ -496,7 +499,9 @@ impl NodeState {
         let covered = (states.len() as u64).saturating_sub(skipped(&self.pipeline) - skipped_before);
         self.stats.record_check(checked.report.check_seconds, covered);
         let world = self.world();
-        if io.collisions.async_publish(checked.message(&world)).await.is_err() {
+        // Never waits: the writer keeps the last N (RustDDS change 10), and this may run on
+        // RustDDS's receiving thread (`states_on_receive.rs`).
+        if io.collisions.publish(checked.message(&world)).is_err() {
             self.log.warn("publish", || format!("publishing on {} failed", io.names.collisions));
         }
         let rate = self.pipeline.params().marker_rate;
@@ -515,7 +520,7 @@ impl NodeState {
     /// get a report each; one report covers all older ones (the polyline through them with
     /// `check_motion`, else the newest of them, the others stale). A waiting sample that does not
     /// decode is counted and skipped.
-    async fn on_joint_states(&mut self, io: &Interfaces, waiting: Vec<ros2_client::ReadResult<(JointState, MessageInfo)>>) {
+    pub(super) fn on_joint_states(&mut self, io: &Interfaces, waiting: Vec<ros2_client::ReadResult<(JointState, MessageInfo)>>) {
         let mut batch = Vec::with_capacity(waiting.len());
         for m in waiting {
             match m {
@@ -535,17 +540,17 @@ impl NodeState {
         // Past SEPARATE_REPORTS waiting, the oldest beyond the newest SEPARATE_REPORTS - 1 share one.
         let (older, newest) = good.split_at(good.len().saturating_sub(SEPARATE_REPORTS - 1));
         if !older.is_empty() {
-            self.publish_report(io, older).await;
+            self.publish_report(io, older);
         }
         for state in newest {
-            self.publish_report(io, std::slice::from_ref(state)).await;
+            self.publish_report(io, std::slice::from_ref(state));
         }
     }
 
-    async fn on_tf(&mut self, io: &Interfaces, msg: TfMessage) {
+    fn on_tf(&mut self, io: &Interfaces, msg: TfMessage) {
         self.stats.received += 1;
         match self.pipeline.tf(&msg) {
-            Ok(state) => self.publish_report(io, std::slice::from_ref(&state)).await,
+            Ok(state) => self.publish_report(io, std::slice::from_ref(&state)),
             Err(skip) => self.warn_skip(&skip),
         }
     }
@@ -616,20 +621,20 @@ impl NodeState {
         }
     }
 
-    async fn on_request(&mut self, io: &Interfaces, id: ros2_client::service::RmwRequestId, req: CheckStatesRequest) {
+    fn on_request(&mut self, io: &Interfaces, id: ros2_client::service::RmwRequestId, req: CheckStatesRequest) {
         let reports = self.pipeline.check_request(&req.states);
         for r in reports.iter().filter(|r| !r.error.is_empty()) {
             let e = r.error.clone();
             self.log.warn("service-state", || format!("{}: a state failed closed: {e}", io.names.check_states));
         }
-        if io.check_states.async_send_response(id, CheckStatesResponse { reports }).await.is_err() {
+        if io.check_states.send_response(id, CheckStatesResponse { reports }).is_err() {
             self.log.warn("service-send", || format!("sending a {} response failed", io.names.check_states));
         }
     }
 
     /// A `check_trajectory` request: resolved by the pipeline here (cheap), checked by the worker.
     /// A refused request is answered at once, as is one past [`MAX_TRAJECTORIES_PENDING`].
-    async fn on_trajectory_request(&mut self, io: &Interfaces, worker: &TrajectoryWorker, id: ros2_client::service::RmwRequestId, req: CheckTrajectoryRequest) {
+    fn on_trajectory_request(&mut self, io: &Interfaces, worker: &TrajectoryWorker, id: ros2_client::service::RmwRequestId, req: CheckTrajectoryRequest) {
         let job = self.pipeline.trajectory_job(&req.trajectory);
         drop(req);
         if job.refused().is_none() {
@@ -642,38 +647,32 @@ impl NodeState {
                         error: format!("busy: {MAX_TRAJECTORIES_PENDING} check_trajectory requests are waiting; try again later"),
                         ..Default::default()
                     };
-                    return self.send_trajectory_answer(io, id, busy).await;
+                    return self.send_trajectory_answer(io, id, busy);
                 }
                 Err(std::sync::mpsc::TrySendError::Disconnected(_)) => {
                     let gone =
                         CheckTrajectoryResponse { segment: -1, fraction: -1.0, error: "the check_trajectory worker has stopped".into(), ..Default::default() };
-                    return self.send_trajectory_answer(io, id, gone).await;
+                    return self.send_trajectory_answer(io, id, gone);
                 }
             }
         }
         let answer = job.run();
-        self.send_trajectory_answer(io, id, answer).await;
+        self.send_trajectory_answer(io, id, answer);
     }
 
-    async fn send_trajectory_answer(&mut self, io: &Interfaces, id: ros2_client::service::RmwRequestId, answer: CheckTrajectoryResponse) {
+    fn send_trajectory_answer(&mut self, io: &Interfaces, id: ros2_client::service::RmwRequestId, answer: CheckTrajectoryResponse) {
         if !answer.error.is_empty() {
             let e = answer.error.clone();
             self.log.warn("service-trajectory", || format!("{}: not valid: {e}", io.names.check_trajectory));
         }
-        if io.check_trajectory.async_send_response(id, answer).await.is_err() {
+        if io.check_trajectory.send_response(id, answer).is_err() {
             self.log.warn("service-send", || format!("sending a {} response failed", io.names.check_trajectory));
         }
     }
 
     /// A `check_state_validity` request: resolved by the pipeline here (cheap), checked by the
     /// worker. A refused request is answered at once, as is one past [`MAX_VALIDITY_PENDING`].
-    async fn on_validity_request(
-        &mut self,
-        io: &Interfaces,
-        worker: &ValidityWorker,
-        id: ros2_client::service::RmwRequestId,
-        req: Box<GetStateValidityRequest>,
-    ) {
+    fn on_validity_request(&mut self, io: &Interfaces, worker: &ValidityWorker, id: ros2_client::service::RmwRequestId, req: Box<GetStateValidityRequest>) {
         let job = self.pipeline.validity_job(&req);
         drop(req);
         if let Some(w) = job.warning() {
@@ -682,30 +681,24 @@ impl NodeState {
         }
         if let Some(reason) = job.refused() {
             let reason = reason.to_owned();
-            return self.send_validity_answer(io, id, GetStateValidityResponse::default(), Some(reason)).await;
+            return self.send_validity_answer(io, id, GetStateValidityResponse::default(), Some(reason));
         }
         let reason = match worker.jobs.try_send((id, job)) {
             Ok(()) => return,
             Err(std::sync::mpsc::TrySendError::Full(_)) => format!("busy: {MAX_VALIDITY_PENDING} check_state_validity requests are waiting"),
             Err(std::sync::mpsc::TrySendError::Disconnected(_)) => "the check_state_validity worker has stopped".to_owned(),
         };
-        self.send_validity_answer(io, id, GetStateValidityResponse::default(), Some(reason)).await;
+        self.send_validity_answer(io, id, GetStateValidityResponse::default(), Some(reason));
     }
 
     /// Sends an answer; a request not honoured is logged (console and `/rosout`) and counted for
     /// `/diagnostics`, as the response has no text field.
-    async fn send_validity_answer(
-        &mut self,
-        io: &Interfaces,
-        id: ros2_client::service::RmwRequestId,
-        answer: GetStateValidityResponse,
-        reason: Option<String>,
-    ) {
+    fn send_validity_answer(&mut self, io: &Interfaces, id: ros2_client::service::RmwRequestId, answer: GetStateValidityResponse, reason: Option<String>) {
         if let Some(reason) = reason {
             self.stats.validity_refused += 1;
             self.log.warn("service-validity", || format!("{}: request not honoured (valid = false): {reason}", io.names.check_state_validity));
         }
-        if io.check_state_validity.async_send_response(id, answer).await.is_err() {
+        if io.check_state_validity.send_response(id, answer).is_err() {
             self.log.warn("service-send", || format!("sending a {} response failed", io.names.check_state_validity));
         }
     }
@@ -755,7 +748,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
             parameter_options(pipeline.params(), changes_tx),
         )
         .map_err(|e| anyhow!("cannot create the node: {e:?}"))?;
-    let io = Interfaces::build(&mut node, pipeline.params(), &opts.ros_args)?;
+    let io = Arc::new(Interfaces::build(&mut node, pipeline.params(), &opts.ros_args)?);
     let param_servers = ParamServers::build(&mut node, ros_mapping(pipeline.params().service_mapping))?;
 
     {
@@ -811,7 +804,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     let validity_worker = ValidityWorker::start()?;
     let spinner = node.spinner().map_err(|e| anyhow!("spinner: {e:?}"))?;
     let fqn = node.fully_qualified_name();
-    let mut state = NodeState {
+    let state = NodeState {
         pipeline,
         stats: NodeStats::default(),
         log: RateLimitedLog::default(),
@@ -824,10 +817,19 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         memory: MemoryReturn::new(),
     };
 
+    let use_tf = io.tf.is_some();
+    let checking = Arc::new(Mutex::new(Checking::new(state, io.clone())));
+    let (on_receive, states_turns) = OnReceive::new(&checking, &io, changes.clone());
+    // Poisoned only by a panic in a check, which ends the process anyway.
+    let hold = || checking.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let tick_events = ticks(TICK)?;
     smol::block_on(async {
         let spin = smol::spawn(spinner.spin());
-        state.publish_cells(&io);
+        hold().state.publish_cells(&io);
+        if !use_tf {
+            // Takes what came before and leaves the receiving thread's waker with the reader.
+            on_receive.answer_waiting(&mut hold(), &io);
+        }
         // Every input as one stream of events. `select_all` polls only the sources that woke it
         // (issue 14): a `select!` over the thirteen polled all of them on every turn, and each
         // poll of an idle DDS reader takes its cache twice and stores a waker.
@@ -839,11 +841,10 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         ) -> Option<Events<'a>> {
             s.map(|s| -> Events<'a> { Box::pin(s.async_stream().map(move |m| m.map_or_else(|e| Event::ReadFailed(what, e), |(m, _)| event(m)))) })
         }
-        let use_tf = io.tf.is_some();
         let sources: Vec<Option<Events>> = vec![
-            // The joint states waiting together come as one event: the stream is read until it
-            // has nothing more, without the notification drain of `take` (two syscalls a state).
-            (!use_tf).then(|| -> Events { Box::pin(io.states.async_stream().ready_chunks(MAX_STATES_PER_TURN).map(Event::States)) }),
+            // Joint states are read by whoever holds the node's state (`states_on_receive.rs`);
+            // this is the receiving thread saying it left them to the loop.
+            (!use_tf).then(|| -> Events { Box::pin(states_turns.map(|()| Event::States)) }),
             read(io.tf.as_ref().map(|t| &t.0), "/tf", Event::Tf),
             read(io.tf.as_ref().map(|t| &t.1), "/tf_static", Event::TfStatic),
             read(Some(&io.descriptions), "robot_description", Event::Description),
@@ -879,40 +880,56 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         while !stop.load(Ordering::SeqCst) {
             if std::mem::take(&mut tick_due) || last_tick.elapsed() >= TICK {
                 last_tick = Instant::now();
-                state.on_tick(&node, &io);
+                hold().state.on_tick(&node, &io);
             }
             // The tick never ends, so neither does this stream.
             let Some(event) = events.next().await else { break };
+            // Parameter answers wait on the writer here; the node's state is not held meanwhile.
+            let event = match event {
+                Event::Parameter(r) => {
+                    if let Some(p) = &param_servers {
+                        if let Err(what) = p.answer(&node, r).await {
+                            hold().state.log.warn("service-send", || format!("sending a {what} response failed"));
+                        }
+                    }
+                    continue;
+                }
+                event => event,
+            };
+            let mut held = hold();
+            let state = &mut held.state;
             // A parameter change accepted before this input arrived applies to it.
             state.apply_params(&io, &changes);
             match event {
-                Event::States(m) => state.on_joint_states(&io, m).await,
-                Event::Tf(m) => state.on_tf(&io, m).await,
+                Event::States => on_receive.answer_waiting(&mut held, &io),
+                Event::Tf(m) => state.on_tf(&io, m),
                 Event::TfStatic(m) => state.on_tf_static(m),
                 Event::Description(m) => state.on_description(&io, m),
                 Event::Semantic(m) => state.on_semantic(&io, m),
                 Event::Clock(t) => state.sim_time = Some(t),
-                Event::Request(id, req) => state.on_request(&io, id, req).await,
-                Event::TrajectoryRequest(id, req) => state.on_trajectory_request(&io, &worker, id, req).await,
-                Event::TrajectoryDone(id, answer) => state.send_trajectory_answer(&io, id, answer).await,
-                Event::ValidityRequest(id, req) => state.on_validity_request(&io, &validity_worker, id, req).await,
-                Event::ValidityDone(id, answer, reason) => state.send_validity_answer(&io, id, answer, reason).await,
+                Event::Request(id, req) => state.on_request(&io, id, req),
+                Event::TrajectoryRequest(id, req) => state.on_trajectory_request(&io, &worker, id, req),
+                Event::TrajectoryDone(id, answer) => state.send_trajectory_answer(&io, id, answer),
+                Event::ValidityRequest(id, req) => state.on_validity_request(&io, &validity_worker, id, req),
+                Event::ValidityDone(id, answer, reason) => state.send_validity_answer(&io, id, answer, reason),
                 Event::ReadFailed(what, e) => state.on_read_failed(what, &e),
-                Event::Parameter(r) => {
-                    if let Some(p) = &param_servers {
-                        if let Err(what) = p.answer(&node, r).await {
-                            state.log.warn("service-send", || format!("sending a {what} response failed"));
-                        }
-                    }
-                }
+                Event::Parameter(_) => {}
                 Event::Tick => tick_due = true,
             }
         }
+        on_receive.stop(&checking);
         if printed.compare_exchange(false, true, Ordering::SeqCst, Ordering::SeqCst).is_ok() {
-            println!("{}", state.shutdown_line());
+            println!("{}", hold().state.shutdown_line());
         }
         drop(spin);
     });
+    // The interfaces go down on this thread, not the receiving one: a waker that took the state
+    // just before the stop lets it go within microseconds.
+    let waited = Instant::now();
+    while Arc::strong_count(&checking) > 1 && waited.elapsed() < STOP_GRACE {
+        std::thread::yield_now();
+    }
+    drop(checking);
     // DDS goes down before the stop counts as done (the participant leaves the domain).
     drop(io);
     drop(node);

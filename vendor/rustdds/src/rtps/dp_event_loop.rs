@@ -352,11 +352,15 @@ impl DPEventLoop {
                   },
                   |l| l.messages_bounded(usize::MAX),
                 );
-                for (packet, origin) in udp_messages {
-                  ev_wrapper
-                    .message_receiver
-                    .handle_received_packet(&packet, origin);
-                }
+                // thickness_collision patch (change 13): readers are woken once the whole
+                // batch is handled.
+                crate::rtps::reader::with_deferred_wakes(|| {
+                  for (packet, origin) in udp_messages {
+                    ev_wrapper
+                      .message_receiver
+                      .handle_received_packet(&packet, origin);
+                  }
+                });
               }
               LOOP_WAKE_TOKEN => {
                 // Queues are drained below, once, for this whole iteration.

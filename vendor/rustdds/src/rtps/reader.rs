@@ -1,4 +1,5 @@
 use std::{
+  cell::{Cell, RefCell},
   collections::BTreeMap,
   fmt, iter,
   rc::Rc,
@@ -72,6 +73,45 @@ pub(crate) enum TimedEvent {
 
 // Some pieces necessary to construct a reader.
 // These can be sent between threads, whereas a Reader cannot.
+// thickness_collision patch (change 13): readers' wakers deferred to the end of a batch.
+thread_local! {
+  static DEFERRING_WAKES: Cell<bool> = const { Cell::new(false) };
+  static DEFERRED_WAKES: RefCell<Vec<Waker>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Runs `f`, the handling of datagrams read from a socket together, and wakes the readers'
+/// wakers it notified only when it returns: a waker that takes its samples at once (on this
+/// thread) then finds every sample of the batch, as a waker on another thread would, instead of
+/// one at a time. (thickness_collision patch, change 13.)
+pub(crate) fn with_deferred_wakes<R>(f: impl FnOnce() -> R) -> R {
+  let outer = DEFERRING_WAKES.with(|d| d.replace(true));
+  let result = f();
+  DEFERRING_WAKES.with(|d| d.set(outer));
+  if !outer {
+    // Taken out while waking: a waker may notify a reader again (woken at once then).
+    let mut wakers = DEFERRED_WAKES.with(|d| std::mem::take(&mut *d.borrow_mut()));
+    for w in wakers.drain(..) {
+      w.wake();
+    }
+    // The allocation is kept for the next batch.
+    DEFERRED_WAKES.with(|d| {
+      let mut d = d.borrow_mut();
+      if d.is_empty() {
+        *d = wakers;
+      }
+    });
+  }
+  result
+}
+
+fn wake_or_defer(w: Waker) {
+  if DEFERRING_WAKES.with(|d| d.get()) {
+    DEFERRED_WAKES.with(|d| d.borrow_mut().push(w));
+  } else {
+    w.wake();
+  }
+}
+
 pub(crate) struct ReaderIngredients {
   pub guid: GUID,
   pub notification_sender: crate::mio_source::NotificationSender,
@@ -1316,12 +1356,15 @@ impl Reader {
   // this reader) likely use of mio channel
   pub fn notify_cache_change(&mut self) {
     // async notify mechanism
-    self
-      .data_reader_waker
-      .lock()
-      .unwrap() // TODO: unwrap
-      .take() // Take to nullify the reference
-      .map(|w| w.wake_by_ref()); // If Some, call wake_by_ref
+    // thickness_collision patch (change 13): the waker is taken out before it is woken, so a
+    // waker that polls the reader at once (and so stores a new waker) does not find this lock
+    // still held by its own thread; and while the event loop handles datagrams read together,
+    // it is woken once they all are (`with_deferred_wakes`).
+    // Take to nullify the reference.
+    let waker = self.data_reader_waker.lock().map_or(None, |mut w| w.take());
+    if let Some(w) = waker {
+      wake_or_defer(w);
+    }
 
     // mio-0.8 / mio-1.2 notify for a caller-owned poll.
     self.poll_event_sender.send();
