@@ -17,6 +17,9 @@ pub struct NodeStats {
     pub check_max: f64,
     /// Checks since the last status.
     pub window_checks: u64,
+    /// Joint states taken and answered on RustDDS's receiving thread (`states_on_receive.rs`);
+    /// the rest of `received` went through the node's loop.
+    pub taken_on_receive: u64,
     /// Received count at the last status.
     pub last_received: u64,
     /// `check_state_validity` requests answered `valid = false` without a check (refused, busy,
@@ -62,6 +65,7 @@ pub fn diagnostics(
         kv("states_received", stats.received.to_string()),
         kv("states_checked", stats.checked.to_string()),
         kv("states_skipped", total.to_string()),
+        kv("states_taken_on_receive", stats.taken_on_receive.to_string()),
         kv("check_seconds_mean", format!("{mean:.9}")),
         kv("check_seconds_max", format!("{:.9}", stats.check_max)),
     ];

@@ -397,7 +397,7 @@ const CONTACT_MARKER_LIFETIME: crate::msgs::DurationMsg = crate::msgs::DurationM
 /// The node's state between messages.
 pub(super) struct NodeState {
     pipeline: Pipeline,
-    stats: NodeStats,
+    pub(super) stats: NodeStats,
     log: RateLimitedLog,
     sim_time: Option<Time>,
     last_markers: Option<Instant>,
@@ -828,7 +828,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         hold().state.publish_cells(&io);
         if !use_tf {
             // Takes what came before and leaves the receiving thread's waker with the reader.
-            on_receive.answer_waiting(&mut hold(), &io);
+            on_receive.answer_waiting(&mut hold(), &io, false);
         }
         // Every input as one stream of events. `select_all` polls only the sources that woke it
         // (issue 14): a `select!` over the thirteen polled all of them on every turn, and each
@@ -901,7 +901,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
             // A parameter change accepted before this input arrived applies to it.
             state.apply_params(&io, &changes);
             match event {
-                Event::States => on_receive.answer_waiting(&mut held, &io),
+                Event::States => on_receive.answer_waiting(&mut held, &io, false),
                 Event::Tf(m) => state.on_tf(&io, m),
                 Event::TfStatic(m) => state.on_tf_static(m),
                 Event::Description(m) => state.on_description(&io, m),

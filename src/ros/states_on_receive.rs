@@ -70,8 +70,9 @@ impl OnReceive {
 
     /// Takes the waiting states (up to [`MAX_STATES_PER_TURN`]) and answers them, leaving this
     /// waker with the reader for the next one. With more waiting than that, the rest is the
-    /// loop's next turn, so neither thread is held by a flood.
-    pub(super) fn answer_waiting(self: &Arc<Self>, checking: &mut Checking, io: &Interfaces) {
+    /// loop's next turn, so neither thread is held by a flood. `on_receive`: called on the
+    /// receiving thread (counted for `/diagnostics`).
+    pub(super) fn answer_waiting(self: &Arc<Self>, checking: &mut Checking, io: &Interfaces, on_receive: bool) {
         let waker = Waker::from(self.clone());
         let mut cx = Context::from_waker(&waker);
         let mut waiting = Vec::new();
@@ -83,6 +84,9 @@ impl OnReceive {
         }
         let more = waiting.len() == MAX_STATES_PER_TURN;
         if !waiting.is_empty() {
+            if on_receive {
+                checking.state.stats.taken_on_receive += waiting.len() as u64;
+            }
             checking.state.on_joint_states(io, waiting);
         }
         if more {
@@ -127,7 +131,7 @@ impl Wake for OnReceive {
         let Some(io) = self.io.upgrade() else { return };
         // A panic here would end RustDDS's thread and leave a node that hears nothing; on the
         // loop's thread it ends the process, and so it does here (the hook has printed it).
-        if std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| self.answer_waiting(&mut held, &io))).is_err() {
+        if std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| self.answer_waiting(&mut held, &io, true))).is_err() {
             eprintln!("[ERROR] thickness_collision: a joint state's check panicked on the receiving thread; exiting");
             std::process::exit(101);
         }
