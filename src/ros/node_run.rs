@@ -351,8 +351,9 @@ impl TrajectoryWorker {
     }
 }
 
-/// Joint states taken in one turn of the loop at most: the rest wait for the next turn, so a
-/// flood cannot keep the loop from a stop request or the other inputs.
+/// Joint states taken in one turn at most (of the loop, or of the receiving thread): the rest
+/// wait for the loop's next turn, so a flood cannot keep the loop from a stop request or the
+/// other inputs, nor RustDDS's thread from its other traffic for long.
 pub(super) const MAX_STATES_PER_TURN: usize = 256;
 
 /// Joint states the reader keeps while the node is busy.
