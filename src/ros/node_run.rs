@@ -914,6 +914,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
                 Event::ValidityRequest(id, req) => state.on_validity_request(&io, &validity_worker, id, req),
                 Event::ValidityDone(id, answer, reason) => state.send_validity_answer(&io, id, answer, reason),
                 Event::ReadFailed(what, e) => state.on_read_failed(what, &e),
+                // Answered above, without the state.
                 Event::Parameter(_) => {}
                 Event::Tick => tick_due = true,
             }

@@ -70,9 +70,9 @@ impl OnReceive {
 
     /// Takes the waiting states (up to [`MAX_STATES_PER_TURN`]) and answers them, leaving this
     /// waker with the reader for the next one. With more waiting than that, the rest is the
-    /// loop's next turn, so neither thread is held by a flood. `on_receive`: called on the
-    /// receiving thread (counted for `/diagnostics`).
-    pub(super) fn answer_waiting(self: &Arc<Self>, checking: &mut Checking, io: &Interfaces, on_receive: bool) {
+    /// loop's next turn, so neither thread is held by a flood. `receiving_thread`: called there
+    /// (counted for `/diagnostics`), not by the loop.
+    pub(super) fn answer_waiting(self: &Arc<Self>, checking: &mut Checking, io: &Interfaces, receiving_thread: bool) {
         let waker = Waker::from(self.clone());
         let mut cx = Context::from_waker(&waker);
         let mut waiting = Vec::new();
@@ -84,7 +84,7 @@ impl OnReceive {
         }
         let more = waiting.len() == MAX_STATES_PER_TURN;
         if !waiting.is_empty() {
-            if on_receive {
+            if receiving_thread {
                 checking.state.stats.taken_on_receive += waiting.len() as u64;
             }
             checking.state.on_joint_states(io, waiting);

@@ -71,8 +71,6 @@ pub(crate) enum TimedEvent {
   DeadlineMissedCheck,
 }
 
-// Some pieces necessary to construct a reader.
-// These can be sent between threads, whereas a Reader cannot.
 // thickness_collision patch (change 13): readers' wakers deferred to the end of a batch.
 thread_local! {
   static DEFERRING_WAKES: Cell<bool> = const { Cell::new(false) };
@@ -112,6 +110,8 @@ fn wake_or_defer(w: Waker) {
   }
 }
 
+// Some pieces necessary to construct a reader.
+// These can be sent between threads, whereas a Reader cannot.
 pub(crate) struct ReaderIngredients {
   pub guid: GUID,
   pub notification_sender: crate::mio_source::NotificationSender,
