@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The latency instrument (issue 14, part 3): a Fast DDS C++ peer (benches/latency/latency.cpp)
-# publishes sensor_msgs/JointState at 1 kHz and 10 kHz for SECONDS each and measures receive time
-# minus send time of the CollisionReport carrying each state's stamp, from three answerers in turn:
+# publishes sensor_msgs/JointState at 1 kHz and 10 kHz, SECONDS per rate to each answerer, and
+# measures receive time minus send time of the CollisionReport carrying each state's stamp, from
+# three answerers:
 #   node        thickness_collision on the bundled workcell, the shipped config/params.yaml
 #               (check_motion true)
 #   Rust relay  examples/ros_relay.rs: ros2-client/RustDDS, the node's QoS and kind of loop, an
@@ -21,7 +22,16 @@
 #                                                  # that node with RUSTDDS_DIRECT_SEND=0 too (every
 #                                                  # report sent by RustDDS's event loop, as before
 #                                                  # its change 12)
-#   TC_LATENCY_ROUNDS=2 ...                        # repeat the whole set, interleaved
+#   TC_LATENCY_ROUNDS=2 ...                        # repeat the whole set
+#   TC_LATENCY_MODE=sequential ...                 # one answerer after the other, SECONDS each
+#                                                  # (before 2026-12-02 19:00 UTC the only way)
+#   TC_LATENCY_SLICE=1 ...                         # seconds per slice in the default mode
+#
+# By default every answerer runs at once, each on a domain of its own, and one sender feeds them
+# in turn, TC_LATENCY_SLICE seconds at a time (the order rotating), until each has had SECONDS:
+# this host stalls the VM for seconds at a time, and measured one after the other, a stall fell
+# on one answerer and not on the one it was compared with. Fed in slices, each answerer sees a
+# continuous motion of its own; an answerer not being fed is idle.
 #
 # Network: every participant binds to 127.0.0.1 (Fast DDS: built-in transports off, one UDPv4
 # transport white-listed to 127.0.0.1, no shared memory, no data sharing; RustDDS: the node's
@@ -33,6 +43,9 @@ seconds="${1:-10}"
 rounds="${TC_LATENCY_ROUNDS:-1}"
 only="${TC_LATENCY_ONLY:-cpp rust node}"
 domain="${TC_LATENCY_DOMAIN:-180}"
+mode="${TC_LATENCY_MODE:-interleave}"
+slice="${TC_LATENCY_SLICE:-1}"
+case $mode in interleave | sequential) ;; *) echo "run_latency.sh: TC_LATENCY_MODE is '$mode'; allowed: interleave, sequential" >&2; exit 2 ;; esac
 export ROS_LOCALHOST_ONLY=1 ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
 
 if [ -z "${TC_LATENCY_IN_NS:-}" ] && unshare -n true 2>/dev/null; then
@@ -76,6 +89,23 @@ start() {  # start WHO DOMAIN: the answerer in the background, its pid in $pid
 
 load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 for round in $(seq 1 "$rounds"); do
+    if [ "$mode" = interleave ]; then
+        # Every answerer up at once, each on its own domain; one sender feeds them in turn.
+        started=() ds=()
+        for who in $only; do
+            start "$who" "$domain"
+            started+=("$pid") ds+=("$domain:$who")
+            domain=$(( domain + 1 ))
+        done
+        list=$(printf '%s\n' "${ds[@]}" | cut -d: -f1 | paste -sd,)
+        "${pin_send[@]}" "$peer" interleave "$list" "$seconds" 1 "$slice" 1000 10000 > "$out/all-$round.jsonl"
+        for dw in "${ds[@]}"; do
+            grep "\"domain\": ${dw%%:*}," "$out/all-$round.jsonl" > "$out/${dw#*:}-$round.jsonl"
+        done
+        for p in "${started[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+        for p in "${started[@]}"; do wait "$p" 2>/dev/null || true; done
+        continue
+    fi
     for who in $only; do
         d=$domain
         domain=$(( domain + 1 ))
@@ -90,15 +120,16 @@ for round in $(seq 1 "$rounds"); do
 done
 load_after=$(cut -d' ' -f1-3 /proc/loadavg)
 
-"$python" - "$out" "$rounds" "$only" "$seconds" "$load_before" "$load_after" "$network" "${TC_LATENCY_PIN:-0}" <<'PY'
+"$python" - "$out" "$rounds" "$only" "$seconds" "$load_before" "$load_after" "$network" "${TC_LATENCY_PIN:-0}" "$mode" "$slice" <<'PY'
 import json, sys, pathlib
-out, rounds, only, seconds, lb, la, network, pin = sys.argv[1:]
+out, rounds, only, seconds, lb, la, network, pin, mode, slice_s = sys.argv[1:]
 out = pathlib.Path(out)
 names = {"node": "thickness_collision node", "rust": "Rust relay (ros2-client)", "cpp": "C++ relay (Fast DDS)",
          "node-loop": "node, handed over and sent by the event loop",
          "node-handover": "node, handed over to its loop", "rust-loop": "Rust relay, sent by the event loop"}
-print(f"{seconds} s per rate after 1 s of warm-up; {network}; load average before {lb}, after {la}; "
-      f"{'sender on CPU 0, answerer on CPU 1' if pin == '1' else 'not pinned'}\n")
+order = (f"answerers up together, fed in turn {slice_s} s at a time" if mode == "interleave" else "one answerer after the other")
+print(f"{seconds} s per rate and answerer after 1 s of warm-up; {order}; {network}; load average before {lb}, after {la}; "
+      f"{'sender on CPU 0, answerers on CPU 1' if pin == '1' else 'not pinned'}\n")
 print("| rate | answerer | round | answered / sent | covered | median (µs) | p99 (µs) | p99.9 (µs) | max (µs) | late sends (> half a period) | check_seconds median / p99 (µs) |")
 print("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
 rows = {}

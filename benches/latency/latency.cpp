@@ -2,6 +2,9 @@
 // built-in transports off, no shared memory, no data sharing (the node's path: RustDDS on UDP).
 //
 //   latency measure  DOMAIN SECONDS WARMUP_S RATE_HZ...   JointState out, CollisionReport in; JSON per rate
+//   latency interleave DOMAIN,DOMAIN... SECONDS WARMUP_S SLICE_S RATE_HZ...
+//                                                         as measure, one answerer per domain, fed in
+//                                                         turn SLICE_S at a time; JSON per rate and answerer
 //   latency relay    DOMAIN                               answers each state with an empty report
 //   latency latejoin DOMAIN TOPIC (markers|string) TIMEOUT_S   a late reader of a latched topic; JSON
 //   latency latched  DOMAIN TOPIC BYTES SECONDS            publishes one latched std_msgs/String
@@ -43,6 +46,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -181,106 +185,162 @@ double pct(const std::vector<double>& sorted, double q) {
     return sorted[std::min(sorted.size() - 1, i == 0 ? 0 : i - 1)];
 }
 
-// One run at `rate` on matched endpoints; prints one JSON line.
-void run_rate(DataWriter* writer, MeasureListener& listener, double rate, double seconds, double warmup);
+// One answerer as the sender sees it: its own participant (each answerer runs on a domain of its
+// own), the state writer and the report reader.
+struct Endpoint {
+    int domain = 0;
+    DomainParticipant* participant = nullptr;
+    DataWriter* writer = nullptr;
+    WriterMatch wmatch;
+    MeasureListener listener;
+    // Per run: the send stamp of each state sent to this answerer, and its late sends.
+    std::vector<int64_t> sent;
+    size_t late = 0;
+    int64_t worst_late = 0;
+};
 
-int measure(int domain, const std::vector<double>& rates, double seconds, double warmup) {
-    auto* p = participant(domain, "latency_measure");
-    auto* states = topic(p, "rt/joint_states", new sensor_msgs::msg::JointStatePubSubType());
-    auto* reports = topic(p, "rt/collisions", new thickness_collision_msgs::msg::CollisionReportPubSubType());
-    auto* pub = p->create_publisher(PUBLISHER_QOS_DEFAULT);
-    auto* sub = p->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
-    static WriterMatch wmatch;
+void open_endpoint(Endpoint& e, int domain, size_t room) {
+    e.domain = domain;
+    e.participant = participant(domain, "latency_measure");
+    auto* states = topic(e.participant, "rt/joint_states", new sensor_msgs::msg::JointStatePubSubType());
+    auto* reports = topic(e.participant, "rt/collisions", new thickness_collision_msgs::msg::CollisionReportPubSubType());
+    auto* pub = e.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
+    auto* sub = e.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
     // A sensor stream as rmw_fastrtps_cpp offers SensorDataQoS: best effort, keep last 5.
-    auto* writer = pub->create_datawriter(states, writer_qos(pub->get_default_datawriter_qos(), false, false, 5), &wmatch);
-    static MeasureListener listener;
+    e.writer = pub->create_datawriter(states, writer_qos(pub->get_default_datawriter_qos(), false, false, 5), &e.wmatch);
+    e.listener.got.resize(room);
+    sub->create_datareader(reports, reader_qos(sub->get_default_datareader_qos(), true, false, 1000), &e.listener);
+}
+
+// One run at `rate`: every answerer is fed in turn, `slice` seconds at a time (the sender's
+// schedule runs on across the switches), until each has had `warmup` + `seconds`; prints one JSON
+// line per answerer.
+void run_rate(std::vector<Endpoint*>& ends, double rate, double seconds, double warmup, double slice);
+
+int measure(const std::vector<int>& domains, const std::vector<double>& rates, double seconds, double warmup, double slice) {
     double most = 0;
     for (double r : rates) most = std::max(most, r);
-    listener.got.resize(size_t(most * (seconds + warmup) * 2) + 1000);
-    sub->create_datareader(reports, reader_qos(sub->get_default_datareader_qos(), true, false, 1000), &listener);
+    std::vector<std::unique_ptr<Endpoint>> owned;
+    std::vector<Endpoint*> ends;
+    for (int d : domains) {
+        owned.push_back(std::make_unique<Endpoint>());
+        open_endpoint(*owned.back(), d, size_t(most * (seconds + warmup) * 2) + 1000);
+        ends.push_back(owned.back().get());
+    }
     int64_t t0 = now_ns(CLOCK_MONOTONIC);
-    while (wmatch.matched == 0 || listener.matched == 0) {
-        if (now_ns(CLOCK_MONOTONIC) - t0 > 30'000'000'000) {
-            std::fprintf(stderr, "latency: no match within 30 s (writer %d, reader %d)\n", wmatch.matched.load(), listener.matched.load());
-            return 1;
+    for (Endpoint* e : ends) {
+        while (e->wmatch.matched == 0 || e->listener.matched == 0) {
+            if (now_ns(CLOCK_MONOTONIC) - t0 > 30'000'000'000) {
+                std::fprintf(stderr, "latency: no match within 30 s on domain %d (writer %d, reader %d)\n", e->domain, e->wmatch.matched.load(),
+                             e->listener.matched.load());
+                return 1;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
         }
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     for (double rate : rates) {
-        run_rate(writer, listener, rate, seconds, warmup);
+        run_rate(ends, rate, seconds, warmup, slice);
     }
     // A clean exit: the peers learn at once that this participant's reader is gone (a reliable
     // writer matched to a reader that vanished without a word waits for it until its lease ends).
-    p->delete_contained_entities();
-    DomainParticipantFactory::get_instance()->delete_participant(p);
+    for (Endpoint* e : ends) {
+        e->participant->delete_contained_entities();
+        DomainParticipantFactory::get_instance()->delete_participant(e->participant);
+    }
     return 0;
 }
 
-void run_rate(DataWriter* writer, MeasureListener& listener, double rate, double seconds, double warmup) {
-    const size_t warm = size_t(rate * warmup), total = warm + size_t(rate * seconds);
-    listener.n.store(0, std::memory_order_release);  // got holds room for the largest run
+void print_stats(const Endpoint& e, double rate, size_t warm) {
+    size_t n = e.listener.n.load(std::memory_order_acquire);
+    std::vector<Received> got(e.listener.got.begin(), e.listener.got.begin() + n);
+    std::sort(got.begin(), got.end(), [](const Received& a, const Received& b) { return a.stamp < b.stamp; });
+    std::vector<double> lat, check;
+    size_t answered = 0, covered = 0, j = 0;
+    int64_t newest = got.empty() ? INT64_MIN : got.back().stamp;
+    for (size_t i = warm; i < e.sent.size(); ++i) {
+        while (j < got.size() && got[j].stamp < e.sent[i]) ++j;
+        if (j < got.size() && got[j].stamp == e.sent[i]) {
+            ++answered;
+            lat.push_back(double(got[j].at - e.sent[i]) / 1e3);
+            check.push_back(got[j].check_seconds * 1e6);
+        }
+        if (e.sent[i] <= newest) ++covered;
+    }
+    std::sort(lat.begin(), lat.end());
+    std::sort(check.begin(), check.end());
+    size_t measured = e.sent.size() - std::min(warm, e.sent.size());
+    std::printf(
+        "{\"domain\": %d, \"rate\": %.0f, \"sent\": %zu, \"answered\": %zu, \"covered\": %zu, \"median_us\": %.1f, \"p99_us\": %.1f, "
+        "\"p999_us\": %.1f, \"max_us\": %.1f, \"late_sends\": %zu, \"worst_send_lateness_us\": %.1f, \"warmup_states\": %zu, "
+        "\"check_median_us\": %.1f, \"check_p99_us\": %.1f}\n",
+        e.domain, rate, measured, answered, covered, pct(lat, 0.5), pct(lat, 0.99), pct(lat, 0.999), lat.empty() ? -1.0 : lat.back(), e.late,
+        double(e.worst_late) / 1e3, warm, pct(check, 0.5), pct(check, 0.99));
+}
+
+void run_rate(std::vector<Endpoint*>& ends, double rate, double seconds, double warmup, double slice) {
+    const size_t warm = size_t(rate * warmup), each = warm + size_t(rate * seconds);
+    const size_t per_slice = std::max<size_t>(1, size_t(rate * slice));
+    for (Endpoint* e : ends) {
+        e->listener.n.store(0, std::memory_order_release);  // got holds room for the largest run
+        e->sent.clear();
+        e->sent.reserve(each);
+        e->late = 0;
+        e->worst_late = 0;
+    }
     // The bundled workcell's arm, moving slowly through free space (a motion for check_motion).
+    // Each answerer sees a continuous motion of its own: its time runs only while it is fed.
     sensor_msgs::msg::JointState js;
     js.header().frame_id("");
     js.name({"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint",
              "finger_left_joint", "finger_right_joint"});
     js.position().assign(8, 0.0);
-    std::vector<int64_t> sent(total);
     const int64_t period = int64_t(1e9 / rate);
     int64_t deadline = now_ns(CLOCK_MONOTONIC) + period;
-    size_t late = 0;
-    int64_t worst_late = 0;
-    for (size_t i = 0; i < total; ++i) {
-        int64_t wake = deadline - SPIN_NS;
-        timespec ts{time_t(wake / 1'000'000'000), long(wake % 1'000'000'000)};
-        while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
-        int64_t m;
-        while ((m = now_ns(CLOCK_MONOTONIC)) < deadline) {}
-        worst_late = std::max(worst_late, m - deadline);
-        if (m - deadline > period / 2) {
-            // Woken late (the machine stalled the sender): the schedule restarts from now rather
-            // than catching up with a burst, which the node would rightly take as one motion.
-            ++late;
-            deadline = m;
+    auto feed = [&](Endpoint* e, size_t count) {
+        for (size_t b = 0; b < count; ++b) {
+            int64_t wake = deadline - SPIN_NS;
+            timespec ts{time_t(wake / 1'000'000'000), long(wake % 1'000'000'000)};
+            while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
+            int64_t m;
+            while ((m = now_ns(CLOCK_MONOTONIC)) < deadline) {}
+            e->worst_late = std::max(e->worst_late, m - deadline);
+            if (m - deadline > period / 2) {
+                // Woken late (the machine stalled the sender): the schedule restarts from now rather
+                // than catching up with a burst, which the node would rightly take as one motion.
+                ++e->late;
+                deadline = m;
+            }
+            double t = double(e->sent.size()) / rate;
+            js.position()[0] = 0.3 * std::sin(2 * M_PI * 0.25 * t);
+            js.position()[1] = -0.5 + 0.2 * std::sin(2 * M_PI * 0.2 * t);
+            js.position()[2] = 0.8 + 0.2 * std::sin(2 * M_PI * 0.3 * t);
+            js.position()[5] = 0.5 * t;
+            int64_t stamp = now_ns(CLOCK_REALTIME);
+            js.header().stamp().sec(int32_t(stamp / 1'000'000'000));
+            js.header().stamp().nanosec(uint32_t(stamp % 1'000'000'000));
+            e->sent.push_back(stamp);
+            e->writer->write(&js);
+            deadline += period;
         }
-        double t = double(i) / rate;
-        js.position()[0] = 0.3 * std::sin(2 * M_PI * 0.25 * t);
-        js.position()[1] = -0.5 + 0.2 * std::sin(2 * M_PI * 0.2 * t);
-        js.position()[2] = 0.8 + 0.2 * std::sin(2 * M_PI * 0.3 * t);
-        js.position()[5] = 0.5 * t;
-        int64_t stamp = now_ns(CLOCK_REALTIME);
-        js.header().stamp().sec(int32_t(stamp / 1'000'000'000));
-        js.header().stamp().nanosec(uint32_t(stamp % 1'000'000'000));
-        sent[i] = stamp;
-        writer->write(&js);
-        deadline += period;
+    };
+    // The warm-up whole, each answerer in turn; then the slices, the answerers' order rotating
+    // from one round of slices to the next so that none always follows the same one (a host's
+    // stall, or a quiet spell, falls on all of them alike).
+    for (Endpoint* e : ends) feed(e, warm);
+    for (size_t r = 0;; ++r) {
+        bool fed = false;
+        for (size_t i = 0; i < ends.size(); ++i) {
+            Endpoint* e = ends[(r + i) % ends.size()];
+            if (e->sent.size() < each) {
+                feed(e, std::min(per_slice, each - e->sent.size()));
+                fed = true;
+            }
+        }
+        if (!fed) break;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1000));
-
-    size_t n = listener.n.load(std::memory_order_acquire);
-    std::vector<Received> got(listener.got.begin(), listener.got.begin() + n);
-    std::sort(got.begin(), got.end(), [](const Received& a, const Received& b) { return a.stamp < b.stamp; });
-    std::vector<double> lat, check;
-    size_t answered = 0, covered = 0, j = 0;
-    int64_t newest = got.empty() ? INT64_MIN : got.back().stamp;
-    for (size_t i = warm; i < total; ++i) {
-        while (j < got.size() && got[j].stamp < sent[i]) ++j;
-        if (j < got.size() && got[j].stamp == sent[i]) {
-            ++answered;
-            lat.push_back(double(got[j].at - sent[i]) / 1e3);
-            check.push_back(got[j].check_seconds * 1e6);
-        }
-        if (sent[i] <= newest) ++covered;
-    }
-    std::sort(lat.begin(), lat.end());
-    std::sort(check.begin(), check.end());
-    size_t measured = total - warm;
-    std::printf(
-        "{\"rate\": %.0f, \"sent\": %zu, \"answered\": %zu, \"covered\": %zu, \"median_us\": %.1f, \"p99_us\": %.1f, "
-        "\"p999_us\": %.1f, \"max_us\": %.1f, \"late_sends\": %zu, \"worst_send_lateness_us\": %.1f, \"warmup_states\": %zu, \"check_median_us\": %.1f, \"check_p99_us\": %.1f}\n",
-        rate, measured, answered, covered, pct(lat, 0.5), pct(lat, 0.99), pct(lat, 0.999), lat.empty() ? -1.0 : lat.back(), late,
-        double(worst_late) / 1e3, warm, pct(check, 0.5), pct(check, 0.99));
+    for (Endpoint* e : ends) print_stats(*e, rate, warm);
     std::fflush(stdout);
 }
 
@@ -369,12 +429,27 @@ int main(int argc, char** argv) {
     if (mode == "measure" && argc >= 6) {
         std::vector<double> rates;
         for (int i = 5; i < argc; ++i) rates.push_back(std::atof(argv[i]));
-        return measure(std::atoi(argv[2]), rates, std::atof(argv[3]), std::atof(argv[4]));
+        return measure({std::atoi(argv[2])}, rates, std::atof(argv[3]), std::atof(argv[4]), std::atof(argv[3]));
+    }
+    if (mode == "interleave" && argc >= 7) {
+        std::vector<int> domains;
+        for (char* d = argv[2];;) {
+            char* rest = nullptr;
+            long v = std::strtol(d, &rest, 10);
+            if (rest == d) break;
+            domains.push_back(int(v));
+            if (*rest != ',') break;
+            d = rest + 1;
+        }
+        std::vector<double> rates;
+        for (int i = 6; i < argc; ++i) rates.push_back(std::atof(argv[i]));
+        return measure(domains, rates, std::atof(argv[3]), std::atof(argv[4]), std::atof(argv[5]));
     }
     if (mode == "latejoin" && argc == 6) return latejoin(std::atoi(argv[2]), argv[3], std::strcmp(argv[4], "markers") == 0, std::atof(argv[5]));
     if (mode == "latched" && argc == 6) return latched(std::atoi(argv[2]), argv[3], size_t(std::atoll(argv[4])), std::atof(argv[5]));
     std::fprintf(stderr,
-                 "usage: latency measure DOMAIN SECONDS WARMUP_S RATE_HZ... | relay DOMAIN | latejoin DOMAIN TOPIC markers|string TIMEOUT_S"
+                 "usage: latency measure DOMAIN SECONDS WARMUP_S RATE_HZ... | interleave DOMAIN,DOMAIN... SECONDS WARMUP_S SLICE_S RATE_HZ..."
+                 " | relay DOMAIN | latejoin DOMAIN TOPIC markers|string TIMEOUT_S"
                  " | latched DOMAIN TOPIC BYTES SECONDS\n");
     return 2;
 }
