@@ -317,7 +317,7 @@ impl Checker {
     fn joint_path<'a>(&'a self, q0: &'a [f64], q1: &[f64]) -> Result<JointPath<'a>, String> {
         let robot = self.robot();
         for q in [q0, q1] {
-            let _ = robot.forward_kinematics(q, &nalgebra::Isometry3::identity()).map_err(|e| e.to_string())?;
+            robot.validate_positions(q).map_err(|e| e.to_string())?;
         }
         // Joint-space step of every joint (mimics from their master).
         let mut delta: Vec<f64> = robot
@@ -365,6 +365,25 @@ mod tests {
             q[checker.robot().joint(name).unwrap()] = *v;
         }
         q
+    }
+
+    /// An end that cannot be posed (non-finite, wrong length) fails the motion closed, with the
+    /// error forward kinematics gives, although the motion no longer poses its ends to find it.
+    #[test]
+    fn a_motion_with_an_end_that_cannot_be_posed_fails_closed() {
+        let c = arm();
+        let free = q(&c, &[]);
+        let base = nalgebra::Isometry3::identity();
+        let mut nan = free.clone();
+        nan[1] = f64::NAN;
+        for (q0, q1) in [(&free, &nan), (&nan, &free), (&free, &free[..free.len() - 1].to_vec())] {
+            let r = c.check_motion(q0, q1).report;
+            let bad = if q0.iter().all(|v| v.is_finite()) { q1 } else { q0 };
+            let expected = c.robot().forward_kinematics(bad, &base).expect_err("an end that cannot be posed").to_string();
+            assert!(r.motion && r.in_collision, "fails closed: {r:?}");
+            assert_eq!(r.error, expected);
+        }
+        assert!(c.check_motion(&free, &free).report.error.is_empty());
     }
 
     /// Points of a part in its link's frame: a hull's vertices, a primitive's extreme points

@@ -477,18 +477,24 @@ impl RobotModel {
         self.joint_index.get(name).copied()
     }
 
-    /// The world pose of every link, given a position for every joint (indexed like `joints`;
-    /// ignored for fixed, floating and planar joints and for mimics, whose value is derived) and
-    /// the pose of the root link in the world.
-    ///
-    /// A slice of the wrong length, or a non-finite position, is an error naming it.
-    pub fn forward_kinematics(&self, positions: &[f64], base: &Isometry3<f64>) -> Result<Vec<Isometry3<f64>>, PositionsError> {
+    /// The error [`RobotModel::forward_kinematics`] would give for `positions`, without the poses.
+    pub fn validate_positions(&self, positions: &[f64]) -> Result<(), PositionsError> {
         if positions.len() != self.joints.len() {
             return Err(PositionsError::Length { expected: self.joints.len(), got: positions.len() });
         }
         if let Some((j, v)) = positions.iter().enumerate().find(|(_, v)| !v.is_finite()) {
             return Err(PositionsError::NonFinite { joint: self.joints[j].name.clone(), value: *v });
         }
+        Ok(())
+    }
+
+    /// The world pose of every link, given a position for every joint (indexed like `joints`;
+    /// ignored for fixed, floating and planar joints and for mimics, whose value is derived) and
+    /// the pose of the root link in the world.
+    ///
+    /// A slice of the wrong length, or a non-finite position, is an error naming it.
+    pub fn forward_kinematics(&self, positions: &[f64], base: &Isometry3<f64>) -> Result<Vec<Isometry3<f64>>, PositionsError> {
+        self.validate_positions(positions)?;
         let mut poses = vec![Isometry3::identity(); self.links.len()];
         poses[self.root] = *base;
         for &ji in &self.order {
