@@ -26,6 +26,8 @@
 #   TC_LATENCY_MODE=sequential ...                 # one answerer after the other, SECONDS each
 #                                                  # (before 2026-12-02 19:00 UTC the only way)
 #   TC_LATENCY_SLICE=1 ...                         # seconds per slice in the default mode
+#   TC_LATENCY_DUMP=DIR ...                        # each answered state's send stamp and latency
+#                                                  # into DIR/<domain>-<rate>.csv (the last round's)
 #
 # By default every answerer runs at once, each on a domain of its own, and one sender feeds them
 # in turn, TC_LATENCY_SLICE seconds at a time (the order rotating), until each has had SECONDS:

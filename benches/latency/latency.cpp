@@ -267,6 +267,18 @@ void print_stats(const Endpoint& e, double rate, size_t warm) {
         }
         if (e.sent[i] <= newest) ++covered;
     }
+    if (const char* dir = std::getenv("TC_LATENCY_DUMP")) {
+        // Each answered state in send order (send stamp in ns, latency in µs), to see when the
+        // tail happens: periodic (a timer in a stack) or scattered (the host).
+        std::string path = std::string(dir) + "/" + std::to_string(e.domain) + "-" + std::to_string(int(rate)) + ".csv";
+        if (FILE* f = std::fopen(path.c_str(), "w")) {
+            for (size_t i = warm, k = 0; i < e.sent.size(); ++i) {
+                while (k < got.size() && got[k].stamp < e.sent[i]) ++k;
+                if (k < got.size() && got[k].stamp == e.sent[i]) std::fprintf(f, "%lld,%.1f\n", (long long)e.sent[i], double(got[k].at - e.sent[i]) / 1e3);
+            }
+            std::fclose(f);
+        }
+    }
     std::sort(lat.begin(), lat.end());
     std::sort(check.begin(), check.end());
     size_t measured = e.sent.size() - std::min(warm, e.sent.size());
