@@ -40,6 +40,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -256,12 +257,14 @@ void print_stats(const Endpoint& e, double rate, size_t warm) {
     std::vector<Received> got(e.listener.got.begin(), e.listener.got.begin() + n);
     std::sort(got.begin(), got.end(), [](const Received& a, const Received& b) { return a.stamp < b.stamp; });
     std::vector<double> lat, check;
+    std::vector<int64_t> answered_stamps;  // beside lat, in send order until lat is sorted
     size_t answered = 0, covered = 0, j = 0;
     int64_t newest = got.empty() ? INT64_MIN : got.back().stamp;
     for (size_t i = warm; i < e.sent.size(); ++i) {
         while (j < got.size() && got[j].stamp < e.sent[i]) ++j;
         if (j < got.size() && got[j].stamp == e.sent[i]) {
             ++answered;
+            answered_stamps.push_back(e.sent[i]);
             lat.push_back(double(got[j].at - e.sent[i]) / 1e3);
             check.push_back(got[j].check_seconds * 1e6);
         }
@@ -272,11 +275,10 @@ void print_stats(const Endpoint& e, double rate, size_t warm) {
         // tail happens: periodic (a timer in a stack) or scattered (the host).
         std::string path = std::string(dir) + "/" + std::to_string(e.domain) + "-" + std::to_string(int(rate)) + ".csv";
         if (FILE* f = std::fopen(path.c_str(), "w")) {
-            for (size_t i = warm, k = 0; i < e.sent.size(); ++i) {
-                while (k < got.size() && got[k].stamp < e.sent[i]) ++k;
-                if (k < got.size() && got[k].stamp == e.sent[i]) std::fprintf(f, "%lld,%.1f\n", (long long)e.sent[i], double(got[k].at - e.sent[i]) / 1e3);
-            }
+            for (size_t i = 0; i < lat.size(); ++i) std::fprintf(f, "%lld,%.1f\n", (long long)answered_stamps[i], lat[i]);
             std::fclose(f);
+        } else {
+            std::fprintf(stderr, "TC_LATENCY_DUMP: cannot write %s: %s\n", path.c_str(), std::strerror(errno));
         }
     }
     std::sort(lat.begin(), lat.end());
