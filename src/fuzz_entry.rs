@@ -153,11 +153,20 @@ fn scratch_dir() -> &'static Path {
     })
 }
 
-/// The bundled workcell (robot and environment), built once; its `check` keeps no state.
+/// The bundled workcell (robot and environment), built once, with the arm's whole state at 0
+/// received (as a node has it once its joint states arrived: requests that leave joints out take
+/// them from it); its `check` keeps no state.
 fn workcell() -> &'static Pipeline {
     static WORKCELL: OnceLock<Pipeline> = OnceLock::new();
     WORKCELL.get_or_init(|| match Pipeline::new(Params::default(), None, None) {
-        Ok(p) => p,
+        Ok(mut p) => {
+            let name: Vec<String> = p.checker().robot().joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
+            let position = vec![0.0; name.len()];
+            if let Err(e) = p.joint_state(&JointState { name, position, ..Default::default() }) {
+                panic!("fuzz_entry: the arm's zero state is refused: {}", e.message);
+            }
+            p
+        }
         Err(e) => panic!("fuzz_entry: the bundled workcell does not load: {e}"),
     })
 }

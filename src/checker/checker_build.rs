@@ -44,6 +44,16 @@ pub enum CheckerError {
     /// The SRDF cannot be read or does not fit the robot.
     #[error("{0}")]
     Srdf(String),
+    /// No link of the robot would be checked: every state would be reported free.
+    #[error("{file}: robot '{robot}' has no link to check: {cause}")]
+    NoCheckedLink {
+        /// The URDF (or `robot_description`).
+        file: String,
+        /// The robot's name.
+        robot: String,
+        /// Why no link is checked, and what to change.
+        cause: String,
+    },
     /// A geometry of a link is not usable.
     #[error("{file}: link '{link}': {what}: {message}")]
     Geometry {
@@ -113,6 +123,9 @@ pub struct Checker {
     motion: std::sync::OnceLock<MotionBounds>,
     /// The link pairs checked against each other.
     self_pairs: SelfPairs,
+    /// `moving[j]`: joint `j` takes a position from joint states and moves a checked link (itself,
+    /// or through a mimic). A state is complete when all of these are known.
+    moving: Vec<bool>,
 }
 
 /// Mesh files read once per build.
@@ -147,6 +160,48 @@ fn primitive_shape(spec: &GeometrySpec, padding: f64) -> Option<TargetShape> {
         GeometrySpec::Mesh { .. } => return None,
     };
     shape.is_valid().then_some(shape)
+}
+
+/// Why `robot` has no checked link, with what would change it.
+fn no_checked_link(params: &Params, robot: &RobotModel, file: &str) -> CheckerError {
+    let with_geometry: Vec<&str> = robot.links.iter().filter(|l| !l.geometry.is_empty()).map(|l| l.name.as_str()).collect();
+    let cause = if !with_geometry.is_empty() {
+        format!(
+            "checked_links {:?} matches none of its {} links with collision geometry ({})",
+            params.checked_links,
+            with_geometry.len(),
+            crate::limits::name_list(&with_geometry)
+        )
+    } else if robot.visual_only_links > 0 && !params.use_visual_when_no_collision {
+        format!(
+            "none of its {} links has <collision> geometry ({} have <visual> only: set use_visual_when_no_collision: true to check those)",
+            robot.links.len(),
+            robot.visual_only_links
+        )
+    } else {
+        format!("none of its {} links has collision or visual geometry", robot.links.len())
+    };
+    CheckerError::NoCheckedLink { file: file.to_owned(), robot: robot.name.clone(), cause }
+}
+
+/// Which joints move a checked link: the actuated joints on the path from each checked link to
+/// the root, a mimic standing for the joint it follows.
+fn moving_joints(robot: &RobotModel, targets: &[LinkTargets]) -> Vec<bool> {
+    let mut moving = vec![false; robot.joints.len()];
+    for t in targets {
+        let mut link = t.link;
+        // The joints form a tree (checked at load): at most one step per link.
+        for _ in 0..robot.links.len() {
+            let Some(j) = robot.parent_joint(link) else { break };
+            let joint = &robot.joints[j];
+            let driver = joint.mimic.map_or(j, |m| m.joint);
+            if robot.joints[driver].is_actuated() {
+                moving[driver] = true;
+            }
+            link = joint.parent;
+        }
+    }
+    moving
 }
 
 /// `robot_base_pose` (x y z roll pitch yaw) as an isometry; `Params::validate` ensures six values.
@@ -188,6 +243,18 @@ impl Checker {
         &self.base
     }
 
+    /// Whether joint `j` (model index) moves a checked link and takes its position from joint
+    /// states: the joints a state must give before it can be checked.
+    pub fn moves_checked_link(&self, j: usize) -> bool {
+        self.moving.get(j).copied().unwrap_or(false)
+    }
+
+    /// Names `file` as the parameters' SRDF of a checker whose SRDF was applied from text held
+    /// elsewhere (the pipeline's, for a robot that comes as a description).
+    pub(crate) fn set_semantic_file_name(&mut self, file: String) {
+        self.params.robot_semantic_file = file;
+    }
+
     /// The self-collision pairs and the SRDF they come from.
     pub fn self_pairs(&self) -> &SelfPairs {
         &self.self_pairs
@@ -215,6 +282,7 @@ impl Checker {
             allowed: self.allowed.clone(),
             motion: self.motion.clone(),
             self_pairs: SelfPairs::default(),
+            moving: self.moving.clone(),
         };
         checker.with_semantic(text, source)
     }
@@ -393,6 +461,10 @@ impl Checker {
             }
             targets.push(LinkTargets { link: li, name: link.name.clone(), parts });
         }
+        if targets.is_empty() {
+            return Err(no_checked_link(&params, &robot, &summary.robot_source));
+        }
+        let moving = moving_joints(&robot, &targets);
         let allowed = targets.iter().map(|t| scene.objects().iter().map(|o| params.is_allowed(&t.name, &o.name)).collect()).collect();
         summary.checked_links = targets.len();
         summary.meshes_read = cache.meshes.len();
@@ -409,6 +481,7 @@ impl Checker {
             allowed,
             motion: std::sync::OnceLock::new(),
             self_pairs: SelfPairs::default(),
+            moving,
         };
         if semantic_file.is_empty() {
             let mut checker = checker;

@@ -28,6 +28,17 @@ pub enum StateError {
     /// A joint is missing and `missing_joint` is `reject`.
     #[error("joint state lacks joint '{0}' (missing_joint: reject)")]
     Missing(String),
+    /// A state that names none of the robot's moving joints (an empty one, another robot's).
+    #[error("{0}")]
+    NotOurRobot(String),
+    /// Under `missing_joint: last`, a joint that moves a checked link has not been received yet.
+    #[error("joint '{first}'{} never received: under missing_joint: last a state is checked once every joint that moves a checked link has been received", if *.more > 0 { format!(" (and {} more)", .more) } else { String::new() })]
+    Incomplete {
+        /// The first such joint, in model order.
+        first: String,
+        /// How many more.
+        more: usize,
+    },
     /// A name that is not a joint of the model, where every name must be one (a service request,
     /// `check --joints`).
     #[error("'{0}' is not a joint of the robot model")]
@@ -67,6 +78,9 @@ pub(crate) fn resolve_positions(model: &RobotModel, names: &[String], positions:
             return Err(StateError::Duplicate(name.clone()));
         }
     }
+    if !q.iter().zip(&model.joints).any(|(v, j)| v.is_some() && j.is_actuated()) {
+        return Err(not_our_robot(model, names));
+    }
     model
         .joints
         .iter()
@@ -77,4 +91,15 @@ pub(crate) fn resolve_positions(model: &RobotModel, names: &[String], positions:
             None => Ok(0.0),
         })
         .collect()
+}
+
+/// The error for a state that gives no position to any of `model`'s actuated joints. A robot
+/// with no actuated joint has only the one pose, which any state stands for.
+pub(crate) fn not_our_robot(model: &RobotModel, names: &[String]) -> StateError {
+    let actuated = model.joints.iter().filter(|j| j.is_actuated()).count();
+    let what = match names.first() {
+        None => "the joint state names no joint".to_owned(),
+        Some(first) => format!("the joint state names none of the {actuated} moving joints of robot '{}' (e.g. '{first}')", model.name),
+    };
+    StateError::NotOurRobot(format!("{what}: another robot's state cannot be checked as this one's"))
 }

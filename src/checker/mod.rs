@@ -14,6 +14,7 @@ mod state_report;
 mod world_motion;
 
 pub use self::checker_build::{BuildSummary, Checker, CheckerError, LinkTargets};
+pub(crate) use self::joint_state::not_our_robot;
 pub use self::joint_state::StateError;
 pub use self::motion::{MotionReport, MAX_SUBINTERVALS};
 pub use self::state_report::{ObjectType, ReportClearance, ReportContact, StateReport};

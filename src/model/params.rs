@@ -212,14 +212,6 @@ pub enum ParamsError {
     },
 }
 
-/// The bundled example workcell (the robot, environment and parameters in `config/`).
-pub fn bundled_config_dir() -> PathBuf {
-    match std::env::var_os("THICKNESS_COLLISION_CONFIG") {
-        Some(dir) => PathBuf::from(dir),
-        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config"),
-    }
-}
-
 impl Params {
     /// Reads the node's section of a ROS 2 parameters file.
     pub fn from_file(path: &Path) -> Result<Params, ParamsError> {

@@ -162,6 +162,15 @@ pub enum ModelError {
         #[source]
         source: PackageError,
     },
+    /// The text is unexpanded xacro (urdf-rs would read past its macros: a robot with nothing
+    /// to check).
+    #[error("{file}: unexpanded xacro ({evidence}); expand it first (`xacro {file} > robot.urdf`) or publish the expanded URDF on robot_description")]
+    Xacro {
+        /// File (or `robot_description`).
+        file: String,
+        /// What marks it as xacro, with its line.
+        evidence: String,
+    },
     /// The joints do not form a tree.
     #[error("{file}: {message}")]
     Structure {
@@ -189,6 +198,9 @@ pub struct RobotModel {
     pub name: String,
     /// Links.
     pub links: Vec<LinkModel>,
+    /// Links with `<visual>` but no `<collision>` geometry whose visuals were not used (said when
+    /// nothing is left to check).
+    pub visual_only_links: usize,
     /// Joints.
     pub joints: Vec<JointModel>,
     /// The root link.
@@ -291,6 +303,9 @@ impl RobotModel {
         }
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         check_xml(text.as_bytes()).map_err(|e| malformed(e.to_string()))?;
+        if let Some(evidence) = super::xacro::xacro_evidence(text, file) {
+            return Err(ModelError::Xacro { file: file.into(), evidence });
+        }
         check_urdf_tags(text).map_err(malformed)?;
         let urdf = contain_panic(|| urdf_rs::read_from_string(text))
             .map_err(|panic| malformed(format!("urdf-rs failed on this text ({panic})")))?
@@ -301,6 +316,7 @@ impl RobotModel {
         }
         let mut link_index = HashMap::new();
         let mut links = Vec::with_capacity(urdf.links.len());
+        let visual_only_links = if use_visual { 0 } else { urdf.links.iter().filter(|l| l.collision.is_empty() && !l.visual.is_empty()).count() };
         for (i, l) in urdf.links.iter().enumerate() {
             if link_index.insert(l.name.clone(), i).is_some() {
                 return Err(structure(format!("link '{}' is defined twice", l.name)));
@@ -459,7 +475,7 @@ impl RobotModel {
         for (j, joint) in joints.iter().enumerate() {
             parent_joint[joint.child] = Some(j);
         }
-        Ok(RobotModel { name: urdf.name, links, joints, root, order, parent_joint, link_index, joint_index })
+        Ok(RobotModel { name: urdf.name, links, visual_only_links, joints, root, order, parent_joint, link_index, joint_index })
     }
 
     /// The joint whose child link `link` is; `None` for the root (or an index out of range).

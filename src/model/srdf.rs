@@ -27,6 +27,16 @@ pub enum SrdfError {
         /// What the parser said.
         message: String,
     },
+    /// The text is unexpanded xacro (read as SRDF it would give no pairs and no groups).
+    #[error(
+        "{origin}: unexpanded xacro ({evidence}); expand it first (`xacro {origin} > robot.srdf`) or publish the expanded SRDF on robot_description_semantic"
+    )]
+    Xacro {
+        /// File or topic.
+        origin: String,
+        /// What marks it as xacro, with its line.
+        evidence: String,
+    },
     /// An element names something the robot lacks, or is missing an attribute.
     #[error("{origin}: <{element}> {message}")]
     Element {
@@ -76,6 +86,9 @@ impl Srdf {
     pub fn parse(text: &str, source: &str, robot: &RobotModel) -> Result<Srdf, SrdfError> {
         let xml = |message: String| SrdfError::Xml { origin: source.to_owned(), message };
         check_xml(text.as_bytes()).map_err(|e| xml(e.to_string()))?;
+        if let Some(evidence) = super::xacro::xacro_evidence(text, source) {
+            return Err(SrdfError::Xacro { origin: source.to_owned(), evidence });
+        }
         let doc = roxmltree::Document::parse(text).map_err(|e| xml(e.to_string()))?;
         let root = doc.root_element();
         if root.tag_name().name() != "robot" {

@@ -1,8 +1,8 @@
 //! Joint states to positions of every joint: validation, merging of partial messages and the
 //! `missing_joint` rule, the same for the node, replay and `check --states`.
 
-use crate::checker::StateError;
-use crate::model::{MissingJoint, RobotModel};
+use crate::checker::{Checker, StateError};
+use crate::model::MissingJoint;
 
 /// Unknown names passed back from one message at most.
 const MAX_UNKNOWN_REPORTED: usize = 64;
@@ -15,21 +15,25 @@ pub(crate) struct JointInput {
 
 impl JointInput {
     /// Nothing received yet for any joint of `robot`.
-    pub fn new(robot: &RobotModel) -> JointInput {
-        JointInput { received: vec![None; robot.joints.len()] }
+    pub fn new(checker: &Checker) -> JointInput {
+        JointInput { received: vec![None; checker.robot().joints.len()] }
     }
 
     /// One message: the position of every joint, or why the message gives no state. A bad message
-    /// changes nothing (it is not merged). Names that are not joints of `robot` are ignored (other
-    /// robots share the topic) and pushed to `unknown`.
+    /// changes nothing (it is not merged), nor does one that names none of the robot's actuated
+    /// joints (another robot's). Names that are not joints of the robot are ignored (other robots
+    /// share the topic) and pushed to `unknown`. Under `last`, a merged state still lacking a joint
+    /// that moves a checked link is not a state yet (MoveIt's current state monitor waits for a
+    /// complete state likewise).
     pub fn ingest(
         &mut self,
-        robot: &RobotModel,
+        checker: &Checker,
         missing: MissingJoint,
         names: &[String],
         positions: &[f64],
         unknown: &mut Vec<String>,
     ) -> Result<Vec<f64>, StateError> {
+        let robot = checker.robot();
         if names.len() != positions.len() {
             return Err(StateError::Lengths { names: names.len(), positions: positions.len() });
         }
@@ -45,11 +49,21 @@ impl JointInput {
                 None => {}
             }
         }
+        let actuated = robot.joints.iter().any(|j| j.is_actuated());
+        if actuated && !given.iter().any(|&(j, _)| robot.joints[j].is_actuated()) {
+            return Err(crate::checker::not_our_robot(robot, names));
+        }
         if missing == MissingJoint::Zero {
             self.received.iter_mut().for_each(|v| *v = None);
         }
         for (j, value) in given {
             self.received[j] = Some(value);
+        }
+        if missing == MissingJoint::Last {
+            let mut lacking = (0..robot.joints.len()).filter(|&j| self.received[j].is_none() && checker.moves_checked_link(j));
+            if let Some(first) = lacking.next() {
+                return Err(StateError::Incomplete { first: robot.joints[first].name.clone(), more: lacking.count() });
+            }
         }
         robot
             .joints

@@ -47,14 +47,53 @@ fn partial_states_from_two_publishers_merge_under_last() {
     let (hit, _) = poses();
     let mut p = pipeline(Params::default());
     assert_eq!(p.params().missing_joint, MissingJoint::Last, "the default merges, as robot_state_publisher does");
-    // The arm publisher, then the gripper publisher: the second state holds both.
-    let a = p.joint_state(&js(&ARM[..6], &hit[..6], 1)).unwrap();
+    // The arm publisher, then the gripper publisher. Until the gripper's joint arrived the state
+    // is not known (MoveIt's current state monitor waits likewise): no state, counted.
+    let a = p.joint_state(&js(&ARM[..6], &hit[..6], 1)).unwrap_err();
+    assert_eq!(a.cause, SkipCause::Incomplete);
+    assert!(a.message.contains("'finger_left_joint' never received"), "{}", a.message);
     let b = p.joint_state(&js(&ARM[6..], &hit[6..], 2)).unwrap();
     let whole = pipeline(Params::default()).joint_state(&js(&ARM, &hit, 2)).unwrap();
     assert_eq!(b, whole, "merged partial states equal the whole state");
-    assert_ne!(a, b, "the gripper's position arrived with the second message");
     assert!(p.check(&b).report.in_collision);
     assert_eq!(p.check(&b).stamp, Time::from_nanos(2));
+    // From then on every partial message gives a state: the rest comes from the merge.
+    let (_, clear) = poses();
+    let c = p.joint_state(&js(&ARM[..6], &clear[..6], 3)).unwrap();
+    let mut both = clear.clone();
+    both[6..].copy_from_slice(&hit[6..]);
+    assert_eq!(c, pipeline(Params::default()).joint_state(&js(&ARM, &both, 3)).unwrap());
+    assert_eq!(p.skipped().get(&SkipCause::Incomplete), Some(&1));
+}
+
+#[test]
+fn last_waits_only_for_the_joints_that_move_a_checked_link() {
+    let (hit, _) = poses();
+    // The forearm is moved by the first three joints alone.
+    let mut p = pipeline(Params { checked_links: vec!["forearm_link".into()], ..Params::default() });
+    let a = p.joint_state(&js(&ARM[..2], &hit[..2], 1)).unwrap_err();
+    assert!(a.message.contains("'elbow_joint' never received"), "{}", a.message);
+    assert!(p.joint_state(&js(&ARM[2..3], &hit[2..3], 2)).is_ok());
+}
+
+#[test]
+fn another_robots_joint_states_are_skipped_on_every_mode() {
+    for missing in [MissingJoint::Last, MissingJoint::Zero, MissingJoint::Reject] {
+        let mut p = pipeline(Params { missing_joint: missing, ..Params::default() });
+        for names in [&["panda_joint1", "panda_joint2"][..], &[]] {
+            let skip = p.joint_state(&js(names, &vec![0.0; names.len()], 1)).unwrap_err();
+            assert_eq!(skip.cause, SkipCause::NotOurRobot, "{missing:?} {names:?}");
+        }
+        // A fixed or mimic joint alone moves nothing either.
+        let skip = p.joint_state(&js(&["finger_right_joint", "tool0_joint"], &[0.0, 0.0], 1)).unwrap_err();
+        assert_eq!(skip.cause, SkipCause::NotOurRobot);
+        assert_eq!(p.skipped().get(&SkipCause::NotOurRobot), Some(&3));
+        // check_states slots: empty and foreign states fail closed with the cause.
+        let foreign = js(&["panda_joint1"], &[0.0], 1);
+        let reports = p.check_request(&[js(&[], &[], 1), foreign]);
+        assert!(reports[0].in_collision && reports[0].error.contains("names no joint"), "{:?}", reports[0]);
+        assert!(reports[1].in_collision && reports[1].error.contains("'panda_joint1' is not a joint"), "{:?}", reports[1]);
+    }
 }
 
 #[test]
@@ -85,17 +124,18 @@ fn bad_messages_are_skipped_counted_and_not_merged() {
     let lengths = p.joint_state(&js(&ARM[..2], &hit[..1], 3)).unwrap_err();
     assert_eq!(lengths.cause, SkipCause::Lengths);
     // A message with a bad position changes nothing: the next partial state merges onto `good`.
-    let after = p.joint_state(&js(&[], &[], 4)).unwrap();
+    let after = p.joint_state(&js(&ARM[..1], &clear[..1], 4)).unwrap();
     let report = |s| StateReport { check_seconds: 0.0, ..p.check(s).report };
     assert_eq!(report(&after), report(&good));
     // Unknown names: ignored, warned once each; a NaN on another robot's joint is not ours.
     let other = p.joint_state(&js(&["other_robot_joint", ARM[0]], &[f64::NAN, clear[0]], 5));
     assert!(other.is_ok());
-    let _ = p.joint_state(&js(&["other_robot_joint"], &[1.0], 6)).unwrap();
+    // A message of unknown names alone is another robot's: skipped, and it breaks no trail.
+    assert_eq!(p.joint_state(&js(&["other_robot_joint"], &[1.0], 6)).unwrap_err().cause, SkipCause::NotOurRobot);
     let warnings = p.take_warnings();
     assert_eq!(warnings.len(), 1, "{warnings:?}");
     assert!(warnings[0].contains("other_robot_joint"));
-    assert_eq!(p.skipped().values().sum::<u64>(), 2);
+    assert_eq!(p.skipped().values().sum::<u64>(), 3);
 }
 
 fn tf_message(prefix: &str, world: &str, checker: &Checker, q: &[f64], ns: i64) -> TfMessage {

@@ -16,9 +16,12 @@ pub enum SkipCause {
     DuplicateName,
     /// An actuated joint never received, under `missing_joint: reject`.
     MissingJoint,
+    /// Under `missing_joint: last`, a joint that moves a checked link not received yet.
+    Incomplete,
     /// A transform that is not finite or not a rotation, or a new frame past the frame limit.
     BadTransform,
-    /// A `/tf` message that names none of the robot's frames (another robot's, a sensor's).
+    /// A `/tf` message that names none of the robot's frames (another robot's, a sensor's), or a
+    /// joint state that names none of its actuated joints.
     NotOurRobot,
     /// A checked link whose frame does not reach `world_frame` yet.
     Unreachable,
@@ -28,12 +31,13 @@ pub enum SkipCause {
 
 impl SkipCause {
     /// Every cause, in the order reports list them.
-    pub const ALL: [SkipCause; 9] = [
+    pub const ALL: [SkipCause; 10] = [
         SkipCause::Undecodable,
         SkipCause::Lengths,
         SkipCause::NonFinite,
         SkipCause::DuplicateName,
         SkipCause::MissingJoint,
+        SkipCause::Incomplete,
         SkipCause::BadTransform,
         SkipCause::NotOurRobot,
         SkipCause::Unreachable,
@@ -48,6 +52,7 @@ impl SkipCause {
             SkipCause::NonFinite => "non_finite",
             SkipCause::DuplicateName => "duplicate_name",
             SkipCause::MissingJoint => "missing_joint",
+            SkipCause::Incomplete => "incomplete",
             SkipCause::BadTransform => "bad_transform",
             SkipCause::NotOurRobot => "not_our_robot",
             SkipCause::Unreachable => "unreachable",

@@ -81,6 +81,10 @@ pub struct Pipeline {
     /// The latest `robot_description_semantic` (SRDF text, and what to call it): applied to
     /// every robot built after it that it fits.
     semantic: Option<(Arc<str>, String)>,
+    /// `semantic` is the parameters' `robot_semantic_file`, held for the robot that comes as a
+    /// `robot_description` because it does not fit the one the files give: a description it
+    /// does not fit is refused, and robots built from files do without it.
+    semantic_deferred: bool,
 }
 
 impl Pipeline {
@@ -92,7 +96,7 @@ impl Pipeline {
     }
 
     fn with_checker(checker: Checker, source: RobotSource, environment: Option<PathBuf>) -> Pipeline {
-        let joints = JointInput::new(checker.robot());
+        let joints = JointInput::new(&checker);
         Pipeline {
             checker: Arc::new(checker),
             source,
@@ -105,7 +109,39 @@ impl Pipeline {
             last_stamp: None,
             trail: None,
             semantic: None,
+            semantic_deferred: false,
         }
+    }
+
+    /// As [`Pipeline::new`], for a front door whose robot may still come as a `robot_description`
+    /// (the node; a bag that recorded one). With no robot file named (the bundled arm stands in),
+    /// an SRDF file that does not fit the bundled arm is not refused here: it is meant for the
+    /// robot to come, and is checked against each description as it arrives (one it does not fit
+    /// is refused). [`Pipeline::semantic_deferred`] says whether that is waiting.
+    pub fn new_expecting_description(params: Params, robot: Option<&Path>, environment: Option<&Path>) -> Result<Pipeline, CheckerError> {
+        let placeholder = robot.is_none() && params.robot_description_file.is_empty();
+        match Pipeline::new(params.clone(), robot, environment) {
+            Err(CheckerError::Srdf(_)) if placeholder && !params.robot_semantic_file.is_empty() => {
+                let file = params.robot_semantic_file.clone();
+                let text = crate::limits::read_regular_text(Path::new(&file), "SRDF", crate::limits::MAX_DESCRIPTION_BYTES)
+                    .map_err(|e| CheckerError::Srdf(format!("robot_semantic_file: {e}")))?;
+                let mut bare = params;
+                bare.robot_semantic_file.clear();
+                let mut checker = Checker::from_params(bare, None, environment)?;
+                checker.set_semantic_file_name(file.clone());
+                let mut pipeline = Self::with_checker(checker, RobotSource::Files { robot: None }, environment.map(Path::to_owned));
+                pipeline.semantic = Some((text.into(), file));
+                pipeline.semantic_deferred = true;
+                Ok(pipeline)
+            }
+            other => other,
+        }
+    }
+
+    /// Whether the parameters' SRDF waits for a `robot_description` it fits (see
+    /// [`Pipeline::new_expecting_description`]): true until one has been applied with it.
+    pub fn semantic_deferred(&self) -> bool {
+        self.semantic_deferred && !matches!(self.source, RobotSource::Description { .. })
     }
 
     /// The checker in force (shared: a batch on other threads keeps the one it started with).
@@ -161,7 +197,7 @@ impl Pipeline {
     pub fn joint_state(&mut self, msg: &JointState) -> Result<RobotState, Skip> {
         let mut unknown = Vec::new();
         let missing = self.params().missing_joint;
-        let result = self.joints.ingest(self.checker.robot(), missing, &msg.name, &msg.position, &mut unknown);
+        let result = self.joints.ingest(&self.checker, missing, &msg.name, &msg.position, &mut unknown);
         for name in unknown {
             if self.unknown_names.len() < MAX_UNKNOWN_NAMES && self.unknown_names.insert(name.clone()) {
                 self.warnings.push(format!("'{name}' is not a joint of the robot model; ignored (warned once)"));
@@ -174,6 +210,8 @@ impl Pipeline {
                     StateError::Lengths { .. } => SkipCause::Lengths,
                     StateError::NonFinite { .. } => SkipCause::NonFinite,
                     StateError::Duplicate(_) => SkipCause::DuplicateName,
+                    StateError::NotOurRobot(_) => SkipCause::NotOurRobot,
+                    StateError::Incomplete { .. } => SkipCause::Incomplete,
                     _ => SkipCause::MissingJoint,
                 };
                 Err(self.skip(cause, e.to_string()))
@@ -332,9 +370,23 @@ impl Pipeline {
     /// current robot stays. Merged joint positions are dropped when the new robot's joints differ.
     pub fn set_robot_description(&mut self, urdf: &str, source: &str) -> Result<(), CheckerError> {
         let params = self.params().clone();
+        let mut params = params;
+        if self.semantic_deferred {
+            // Applied below from the text read at start, where a misfit refuses the robot.
+            params.robot_semantic_file.clear();
+        }
         let mut checker =
             crate::limits::contain_panic(|| Checker::from_description(params, urdf, source, self.environment.as_deref())).map_err(CheckerError::Panicked)??;
-        self.apply_latest_semantic(&mut checker);
+        if self.semantic_deferred {
+            if let Some((text, file)) = &self.semantic {
+                crate::limits::contain_panic(|| checker.apply_semantic(text, file))
+                    .map_err(CheckerError::Panicked)?
+                    .map_err(|e| CheckerError::Srdf(format!("robot_semantic_file {file} does not fit this robot: {e}")))?;
+                checker.set_semantic_file_name(file.clone());
+            }
+        } else {
+            self.apply_latest_semantic(&mut checker);
+        }
         self.source = RobotSource::Description { urdf: urdf.into(), source: source.to_owned() };
         self.replace(checker);
         Ok(())
@@ -343,9 +395,21 @@ impl Pipeline {
     /// New parameters: the checker is rebuilt with the robot from the same source (a robot
     /// received as a description stays); on error everything stays as it was.
     pub fn set_params(&mut self, params: Params) -> Result<(), CheckerError> {
-        let checker = self.rebuild(params)?;
-        self.replace(checker);
-        Ok(())
+        let was_deferred = self.semantic_deferred;
+        // A different SRDF file is a new choice, checked against the robot in force.
+        if self.semantic.as_ref().is_none_or(|(_, file)| *file != params.robot_semantic_file) {
+            self.semantic_deferred = false;
+        }
+        match self.rebuild(params) {
+            Ok(checker) => {
+                self.replace(checker);
+                Ok(())
+            }
+            Err(e) => {
+                self.semantic_deferred = was_deferred;
+                Err(e)
+            }
+        }
     }
 
     /// A new SRDF (a `robot_description_semantic` message), swapped in whole: its
@@ -355,6 +419,7 @@ impl Pipeline {
     pub fn set_robot_semantic(&mut self, text: &str, source: &str) -> Result<(), CheckerError> {
         // Kept even when it does not fit this robot: the robot it belongs to may come next.
         self.semantic = Some((text.into(), source.to_owned()));
+        self.semantic_deferred = false;
         let checker = crate::limits::contain_panic(|| self.checker.with_other_semantic(text, source)).map_err(CheckerError::Panicked)??;
         self.replace(checker);
         Ok(())
@@ -364,11 +429,25 @@ impl Pipeline {
     /// received when it fits (else the parameters' file or the default pairs, with a warning).
     fn rebuild(&mut self, params: Params) -> Result<Checker, CheckerError> {
         let mut checker = self.build_from_source(params)?;
-        self.apply_latest_semantic(&mut checker);
+        if !self.semantic_deferred {
+            self.apply_latest_semantic(&mut checker);
+        }
         Ok(checker)
     }
 
-    fn build_from_source(&self, params: Params) -> Result<Checker, CheckerError> {
+    fn build_from_source(&self, mut params: Params) -> Result<Checker, CheckerError> {
+        let deferred = self.semantic_deferred.then(|| std::mem::take(&mut params.robot_semantic_file));
+        let mut checker = self.build_checker(params)?;
+        if let Some(file) = deferred {
+            if let (RobotSource::Description { .. }, Some((text, _))) = (&self.source, &self.semantic) {
+                checker.apply_semantic(text, &file).map_err(|e| CheckerError::Srdf(format!("robot_semantic_file {file} does not fit this robot: {e}")))?;
+            }
+            checker.set_semantic_file_name(file);
+        }
+        Ok(checker)
+    }
+
+    fn build_checker(&self, params: Params) -> Result<Checker, CheckerError> {
         crate::limits::contain_panic(|| match &self.source {
             RobotSource::Files { robot } => Checker::from_params(params, robot.as_deref(), self.environment.as_deref()),
             RobotSource::Description { urdf, source } => Checker::from_description(params, urdf, source, self.environment.as_deref()),
@@ -389,7 +468,7 @@ impl Pipeline {
     fn replace(&mut self, checker: Checker) {
         let same_joints = checker.robot().joints.iter().map(|j| &j.name).eq(self.checker.robot().joints.iter().map(|j| &j.name));
         if !same_joints {
-            self.joints = JointInput::new(checker.robot());
+            self.joints = JointInput::new(&checker);
         }
         self.checker = Arc::new(checker);
         // The next state is checked on its own: the last one belongs to the old robot or

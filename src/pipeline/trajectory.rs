@@ -127,12 +127,20 @@ fn resolve(pipeline: &Pipeline, trajectory: &JointTrajectory) -> Result<Plan, St
     // Joints the trajectory leaves out: the current merged state, else the missing_joint rule.
     let missing = pipeline.params().missing_joint;
     let mut base = Vec::with_capacity(robot.joints.len());
-    for ((joint, current), named) in robot.joints.iter().zip(pipeline.current_joints()).zip(&seen) {
+    for (ji, ((joint, current), named)) in robot.joints.iter().zip(pipeline.current_joints()).zip(&seen).enumerate() {
         base.push(match current {
             _ if *named => 0.0,
             Some(v) => *v,
             None if joint.is_actuated() && missing == MissingJoint::Reject => {
                 return Err(format!("joint '{}' is neither in joint_names nor in a joint state received so far (missing_joint: reject)", joint.name))
+            }
+            // Under `last` an unknown joint that moves a checked link leaves the robot's pose
+            // unknown: checking it at 0 could call a colliding trajectory free.
+            None if missing == MissingJoint::Last && pipeline.checker().moves_checked_link(ji) => {
+                return Err(format!(
+                    "joint '{}' is neither in joint_names nor in a joint state received so far (missing_joint: last takes it from the joint states)",
+                    joint.name
+                ))
             }
             None => 0.0,
         });
@@ -253,8 +261,18 @@ mod tests {
     use crate::model::Params;
     use crate::msgs::{JointState, JointTrajectoryPoint};
 
-    fn arm(missing: MissingJoint) -> Pipeline {
+    /// The arm with nothing received yet.
+    fn fresh(missing: MissingJoint) -> Pipeline {
         Pipeline::new(Params { missing_joint: missing, ..Params::default() }, None, None).unwrap()
+    }
+
+    /// The arm once its whole state at 0 was received, as a running node has it.
+    fn arm(missing: MissingJoint) -> Pipeline {
+        let mut p = fresh(missing);
+        let name: Vec<String> = p.checker().robot().joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
+        let position = vec![0.0; name.len()];
+        let _ = p.joint_state(&JointState { name, position, ..Default::default() }).unwrap();
+        p
     }
 
     fn point(positions: &[f64], sec: i32, nanosec: u32) -> JointTrajectoryPoint {
@@ -290,7 +308,7 @@ mod tests {
         let names: Vec<String> = arm(MissingJoint::Last).checker().robot().joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
         let t = trajectory(&["elbow_joint"], vec![point(&[0.3], 0, 0), point(&[0.4], 1, 0)]);
         // reject: nothing received yet, the request is refused naming a joint it lacks.
-        let mut p = arm(MissingJoint::Reject);
+        let mut p = fresh(MissingJoint::Reject);
         let r = p.check_trajectory(&t);
         assert!(!r.valid && r.error.contains("missing_joint: reject"), "{r:?}");
         // Once a full state arrived, the same request is checked, from that state.
@@ -302,9 +320,11 @@ mod tests {
         let plan = job.plan.as_ref().unwrap();
         let elbow = p.checker().robot().joint("elbow_joint").unwrap();
         assert_eq!((plan.q[0][lift], plan.q[1][lift], plan.q[0][elbow], plan.q[1][elbow]), (0.7, 0.7, 0.3, 0.4));
-        // last: a joint never received is 0.
-        let p = arm(MissingJoint::Last);
-        let job = p.trajectory_job(&t);
+        // last: a joint that moves a checked link, never received, leaves the pose unknown.
+        let r = fresh(MissingJoint::Last).check_trajectory(&t);
+        assert!(!r.valid && r.segment == -1 && r.error.contains("'shoulder_pan_joint' is neither") && r.error.contains("missing_joint: last"), "{r:?}");
+        // zero: it is 0.
+        let job = fresh(MissingJoint::Zero).trajectory_job(&t);
         assert_eq!(job.plan.as_ref().unwrap().q[1][lift], 0.0);
     }
 

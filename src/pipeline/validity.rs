@@ -151,11 +151,17 @@ fn resolve(pipeline: &Pipeline, req: &GetStateValidityRequest) -> Result<Vec<f64
         .iter()
         .zip(given)
         .zip(pipeline.current_joints())
-        .map(|((joint, given), current)| match given.or(*current) {
+        .enumerate()
+        .map(|(ji, ((joint, given), current))| match given.or(*current) {
             Some(v) => Ok(v),
             None if joint.is_actuated() && missing == MissingJoint::Reject => {
                 Err(format!("joint '{}' is neither in the request nor in a joint state received so far (missing_joint: reject)", joint.name))
             }
+            // As for a trajectory: a joint that moves a checked link, known from nowhere.
+            None if missing == MissingJoint::Last && pipeline.checker().moves_checked_link(ji) => Err(format!(
+                "joint '{}' is neither in the request nor in a joint state received so far (missing_joint: last takes it from the joint states)",
+                joint.name
+            )),
             None => Ok(0.0),
         })
         .collect()
@@ -270,8 +276,18 @@ mod tests {
     use crate::msgs::moveit::{AttachedCollisionObject, JointConstraint, RobotStateMsg};
     use crate::msgs::{JointState, Transform};
 
-    fn arm(missing: MissingJoint) -> Pipeline {
+    /// The arm with nothing received yet.
+    fn fresh(missing: MissingJoint) -> Pipeline {
         Pipeline::new(Params { missing_joint: missing, ..Params::default() }, None, None).unwrap()
+    }
+
+    /// The arm once its whole state at 0 was received, as a running node has it.
+    fn arm(missing: MissingJoint) -> Pipeline {
+        let mut p = fresh(missing);
+        let name: Vec<String> = p.checker().robot().joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
+        let position = vec![0.0; name.len()];
+        let _ = p.joint_state(&JointState { name, position, ..Default::default() }).unwrap();
+        p
     }
 
     fn request(names: &[&str], positions: &[f64]) -> GetStateValidityRequest {
@@ -346,7 +362,10 @@ mod tests {
 
     #[test]
     fn the_request_applies_on_top_of_the_merged_state_whatever_is_diff_says() {
-        let mut p = arm(MissingJoint::Reject);
+        // Nothing received under last: a joint that moves a checked link, left out, is refused.
+        let (r, why) = fresh(MissingJoint::Last).check_validity(&request(&["elbow_joint"], &[0.3]));
+        assert!(!r.valid && why.as_deref().unwrap_or_default().contains("missing_joint: last"), "{why:?}");
+        let mut p = fresh(MissingJoint::Reject);
         // Nothing received: a joint the request leaves out is refused under reject.
         let (r, why) = p.check_validity(&request(&["elbow_joint"], &[0.3]));
         assert!(!r.valid && why.unwrap_or_default().contains("missing_joint: reject"));

@@ -165,7 +165,12 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
     }
     // Both doors start with the robot the parameters name; a description in the bag replaces it
     // at its log time, as it would replace it in the running node.
-    let mut pipeline = Pipeline::new(params, robot, environment)?;
+    let mut pipeline = if bag.topics().iter().any(|(t, _)| t == DESCRIPTION_TOPIC) {
+        // An SRDF given for the recorded robot is checked against it when it comes.
+        Pipeline::new_expecting_description(params, robot, environment)?
+    } else {
+        Pipeline::new(params, robot, environment)?
+    };
 
     let mut out = Outputs {
         jsonl: match &opts.jsonl {
@@ -276,6 +281,15 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
     if let Some((timeline, path)) = &out.plot {
         let svg = timeline_svg(timeline, &opts.bag.display().to_string()).map_err(anyhow::Error::msg)?;
         std::fs::write(path, svg).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if pipeline.semantic_deferred() {
+        bail!(
+            "robot_semantic_file {} fits neither the bundled arm nor a {DESCRIPTION_TOPIC} of bag {} ({} applied, {} refused)",
+            pipeline.params().robot_semantic_file,
+            opts.bag.display(),
+            summary.descriptions.0,
+            summary.descriptions.1
+        );
     }
     summary.seconds = started.elapsed().as_secs_f64();
     summary.skipped = pipeline.skipped().clone();

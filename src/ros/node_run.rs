@@ -737,7 +737,8 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     // Before the model is built and DDS starts its threads: the thresholds apply from here on.
     memory_return::fix_allocator_thresholds();
     let params = params.with_overrides(&opts.ros_args.params)?;
-    let pipeline = Pipeline::new(params, opts.robot.as_deref(), opts.environment.as_deref())?;
+    // The robot may come as a robot_description: an SRDF meant for it waits for it.
+    let pipeline = Pipeline::new_expecting_description(params, opts.robot.as_deref(), opts.environment.as_deref())?;
     let (dp, domain, discovery) = participant()?;
     let context = Context::from_domain_participant(dp).map_err(|e| anyhow!("ROS context: {e:?}"))?;
     let namespace = opts.ros_args.namespace.clone().unwrap_or_else(|| "/".into());
@@ -757,6 +758,9 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         let p = pipeline.params();
         println!("thickness_collision: node {} on DDS domain {domain}, discovery range {}", node.fully_qualified_name(), discovery.describe());
         println!("  robot {} ({} links, {} checked)", s.robot_source, s.robot_links, s.checked_links);
+        if pipeline.semantic_deferred() {
+            println!("  SRDF {} does not fit this robot: it waits for a robot_description it fits", p.robot_semantic_file);
+        }
         println!(
             "  environment {} ({} thin surfaces, {} cells, {} solids), built in {:.1} ms",
             s.environment_source,
