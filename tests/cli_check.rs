@@ -41,12 +41,13 @@ fn json_lines_agree_across_input_forms_and_runs() {
     }
     assert_eq!(c["object_name"], "guard_sheet");
 
-    // The same state in a states file, after a clear one and an unknown joint (a warning only).
+    // The same state in a states file, after a clear whole one with an unknown joint (a warning
+    // only): the second line merges onto the first.
     let states = tmp("states.jsonl");
     std::fs::write(
         &states,
         concat!(
-            r#"{"name": ["shoulder_pan_joint", "other_robot_joint"], "position": [0.0, 1.0]}"#,
+            r#"{"name": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint", "other_robot_joint"], "position": [0, 0, 0, 0, 0, 0, 0, 1.0]}"#,
             "\n",
             r#"{"name": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"], "position": [0, 1.2, 0.3]}"#,
             "\n",

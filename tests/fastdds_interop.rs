@@ -82,7 +82,7 @@ fn fastdds_topics_services_parameters_and_latched_markers() {
     let states: Vec<Value> = (0..25).map(|k| state_json(k, 1_000_000_000 + k as i64)).collect();
     let reference = common::check_json(&dir, "states", &states, &[]);
     assert!(reference.iter().any(|r| r["in_collision"] == true) && reference.iter().any(|r| r["in_collision"] == false));
-    let a = peer.send(&json!({"cmd": "states", "states": states, "warm": {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}, "timeout": 30}));
+    let a = peer.send(&json!({"cmd": "states", "states": states, "warm": common::whole_arm_warm_up(), "timeout": 30}));
     assert_eq!(a["matched"], true, "no match on joint_states/collisions: {a}");
     assert!(a["warm_reports"].as_u64().unwrap() >= 1, "the node never answered the warm-up state: {a}");
     let reports = a["reports"].as_array().unwrap();
@@ -328,7 +328,7 @@ fn fastdds_latched_robot_description_is_taken_by_a_node_started_after_it() {
             Err(_) => panic!("the node did not take the latched robot_description within 30 s; its output: {seen}"),
         }
     }
-    let a = peer.send(&json!({"cmd": "states", "states": states, "warm": {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}, "timeout": 30}));
+    let a = peer.send(&json!({"cmd": "states", "states": states, "warm": common::whole_arm_warm_up(), "timeout": 30}));
     assert_eq!(a["matched"], true, "{a}");
     let readers = peer.send(&json!({"cmd": "status"}))["description_readers"].as_u64().unwrap();
     assert!(readers >= 1, "the node's robot_description reader matched the latched writer");

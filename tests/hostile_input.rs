@@ -365,9 +365,11 @@ fn errors_are_one_line_a_person_can_act_on() {
 fn bag(name: &str, description: Option<String>) -> PathBuf {
     let path = scratch().join(name);
     let _ = std::fs::remove_dir_all(&path);
-    let names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"];
-    let messages: Vec<Value> =
-        (0..5).map(|i| json!({"t": 1_000_000_000 + i * 100_000_000, "stamp": i, "name": names, "position": [0.0, 1.2 * i as f64 / 4.0, 0.3]})).collect();
+    // Every actuated joint: under missing_joint: last nothing is checked before all arrived.
+    let names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
+    let messages: Vec<Value> = (0..5)
+        .map(|i| json!({"t": 1_000_000_000 + i * 100_000_000, "stamp": i, "name": names, "position": [0.0, 1.2 * i as f64 / 4.0, 0.3, 0.0, 0.0, 0.0, 0.0]}))
+        .collect();
     let _ = common::run_peer("bag_tool.py", &json!({"op": "write", "path": path, "storage": "mcap", "messages": messages, "robot_description": description}));
     path
 }

@@ -138,7 +138,10 @@ fn check_motion_on_the_command_line() {
     std::fs::create_dir_all(&dir).unwrap();
     let states = dir.join("path.jsonl");
     let line = |lift: f64, elbow: f64| format!("{{\"name\": [\"shoulder_lift_joint\", \"elbow_joint\"], \"position\": [{lift}, {elbow}]}}\n");
-    std::fs::write(&states, line(0.0, 0.0) + &line(0.3, 0.0) + &line(1.2, 0.3)).unwrap();
+    // The first waypoint is the whole arm (missing_joint: last waits for every joint); the others
+    // move two joints.
+    let first = "{\"name\": [\"shoulder_pan_joint\", \"shoulder_lift_joint\", \"elbow_joint\", \"wrist_1_joint\", \"wrist_2_joint\", \"wrist_3_joint\", \"finger_left_joint\"], \"position\": [0, 0, 0, 0, 0, 0, 0]}\n";
+    std::fs::write(&states, first.to_owned() + &line(0.3, 0.0) + &line(1.2, 0.3)).unwrap();
     let out =
         Command::new(env!("CARGO_BIN_EXE_thickness_collision")).args(["check", "--motion", "--json", "--states", states.to_str().unwrap()]).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

@@ -190,7 +190,7 @@ fn fastdds_in_b(hosts: &TwoHosts, domain: u32, peers: &[&str], states: &[(Vec<&s
     let opts = PeerOptions { wrapper: hosts.in_b(), domain, interface: HOST_B.into(), peers: peers.iter().map(|p| p.to_string()).collect(), env: vec![] };
     let mut peer = FastDdsPeer::start(&opts);
     let js: Vec<Value> = states.iter().enumerate().map(|(k, (n, p))| json!({"name": n, "position": p, "stamp": 2_000_000_000 + k})).collect();
-    let a = peer.send(&json!({"cmd": "states", "states": js, "warm": {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}, "timeout": 30}));
+    let a = peer.send(&json!({"cmd": "states", "states": js, "warm": common::whole_arm_warm_up(), "timeout": 30}));
     if a["matched"] != true {
         return Err(format!("no match on joint_states/collisions: {a}"));
     }

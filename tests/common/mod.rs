@@ -178,3 +178,10 @@ pub fn same_report(got: &serde_json::Value, want: &serde_json::Value, what: &str
         }
     }
 }
+
+/// A warm-up state for a node on the bundled arm: every actuated joint at 0 (under the default
+/// `missing_joint: last` nothing is reported before each has been received), stamped 1 ns.
+pub fn whole_arm_warm_up() -> serde_json::Value {
+    let name = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
+    serde_json::json!({"name": name, "position": [0.0; 7], "stamp": 1})
+}

@@ -58,6 +58,10 @@ def call(dp, service, req_type, resp_type, request, wait=None, make=None):
     return None
 
 
+# Every actuated joint of the bundled arm (missing_joint: last waits for all of them).
+ARM = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"]
+
+
 def js(s):
     ns = int(s.get("stamp", 0))
     return JointState(header=Header(stamp=Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000), frame_id=""),
@@ -133,14 +137,14 @@ if req.get("robot_descriptions"):
 
 burst = req.get("burst", 0)
 for k in range(burst):
-    writer.write(js({"name": ["elbow_joint"], "position": [(k % 100) / 100.0], "stamp": k}))
+    writer.write(js({"name": ARM, "position": [0.0, 0.0, (k % 100) / 100.0, 0.0, 0.0, 0.0, 0.0], "stamp": k}))
 if burst:
     time.sleep(1.0)
     collect(10 ** 9, 1.0)
 
 # Warm-up: the node may not have matched our writer yet; send until a report comes back.
 if req.get("states") or req.get("bad"):
-    warm = {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}
+    warm = {"name": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"], "position": [0.0] * 7, "stamp": 1}  # the whole arm: missing_joint: last waits for it
     end = time.time() + req.get("warmup", 15)
     while time.time() < end and not collect(1, 0.5):
         writer.write(js(warm))

@@ -128,7 +128,7 @@ def one_report(s, wait=10):
 
 
 # Warm-up: a report for a valid state, so the node reads our writer before the hostile part.
-warm = {"name": ["elbow_joint"], "position": [0.0], "stamp": 1}
+warm = {"name": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"], "position": [0.0] * 7, "stamp": 1}  # the whole arm: missing_joint: last waits for it
 out["warm_report"] = one_report(warm, 15) is not None
 drain_reports(0.3)
 

@@ -36,9 +36,14 @@ def stamp_ns(r):
     return r.header.stamp.sec * 1_000_000_000 + r.header.stamp.nanosec
 
 
+# Every actuated joint of the bundled arm: under missing_joint: last the node reports nothing until
+# each has been received.
+ARM = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"]
+
+
 def js(k, ns):
     return T.JointState(header=T.Header(stamp=T.Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000), frame_id=""),
-                        name=["elbow_joint"], position=[(k % 100) / 100.0], velocity=[], effort=[])
+                        name=ARM, position=[0.0, 0.0, (k % 100) / 100.0, 0.0, 0.0, 0.0, 0.0], velocity=[], effort=[])
 
 
 def say(obj):
