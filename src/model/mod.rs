@@ -12,6 +12,9 @@ mod srdf;
 pub mod xml_guard;
 
 pub use self::package::{PackageError, PackageResolver};
-pub use self::params::{bundled_config_dir, glob_match, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};
+pub use self::params::{
+    bundled_config_dir, glob_match, node_fqn, LoadedParams, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces,
+    DEFAULT_NODE_FQN,
+};
 pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, PositionsError, RobotModel};
 pub use self::srdf::{Srdf, SrdfError};
