@@ -88,6 +88,15 @@ fn participant() -> Result<(DomainParticipant, u16, DiscoverySettings)> {
     Ok((builder.build().context("cannot create the DDS participant")?, domain, discovery))
 }
 
+/// The line a refused description is logged and diagnosed with: the topic once, then why. The
+/// error names its source (`/robot_description topic: ...`) when it comes from the text itself;
+/// that prefix is dropped, as the line already starts with the topic.
+fn refusal_line(topic: &str, source: &str, what_stays: &str, error: &str) -> String {
+    let error = error.replace('\n', " ");
+    let reason = error.strip_prefix(source).and_then(|r| r.strip_prefix(": ")).unwrap_or(&error);
+    format!("{topic} rejected, {what_stays}: {reason}")
+}
+
 /// The largest domain id: RTPS ports are `7400 + 250 * domain + ...`, and above 232 they pass
 /// 65535 and wrap (the limit the ROS 2 "Domain ID" article gives).
 const MAX_DOMAIN_ID: u16 = 232;
@@ -592,8 +601,7 @@ impl NodeState {
                 self.publish_cells(io);
             }
             Err(e) => {
-                // One line whatever the error text holds.
-                let line = format!("{} rejected, keeping the current robot: {}", io.names.description, e.replace('\n', " "));
+                let line = refusal_line(&io.names.description, &source, "keeping the current robot", &e);
                 eprintln!("[ERROR] thickness_collision: {line}");
                 if self.log.pending.len() < 64 {
                     self.log.pending.push(line.clone());
@@ -624,7 +632,7 @@ impl NodeState {
                 self.description_error = None;
             }
             Err(e) => {
-                let line = format!("{} rejected, keeping the current collision matrix: {}", io.names.semantic, e.replace('\n', " "));
+                let line = refusal_line(&io.names.semantic, &source, "keeping the current collision matrix", &e);
                 eprintln!("[ERROR] thickness_collision: {line}");
                 if self.log.pending.len() < 64 {
                     self.log.pending.push(line.clone());
@@ -955,6 +963,16 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_refused_description_names_its_topic_once() {
+        let source = "/robot_description topic";
+        let line = refusal_line("/robot_description", source, "keeping the current robot", "/robot_description topic: malformed URDF: x\ny");
+        assert_eq!(line, "/robot_description rejected, keeping the current robot: malformed URDF: x y");
+        // An error about another file keeps its own prefix.
+        let line = refusal_line("/robot_description", source, "keeping the current robot", "env.urdf: link 'a': bad");
+        assert_eq!(line, "/robot_description rejected, keeping the current robot: env.urdf: link 'a': bad");
+    }
 
     #[test]
     fn domain_id_is_0_to_232() {
