@@ -42,16 +42,16 @@ pub use crate::pipeline::MAX_TRAJECTORY_SUBINTERVALS;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum InputFileError {
-    /// `open` or `read` failed.
-    #[error("{what} {path}: {source}")]
+    /// `open` or `read` failed. (The I/O error is part of the message, not a `source`: printed
+    /// as a chain it would repeat itself.)
+    #[error("{what} {path}: {error}")]
     Io {
         /// What the file was for ("URDF file", "mesh file", ...).
         what: &'static str,
         /// The file.
         path: PathBuf,
         /// Why.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// A FIFO, a device, a socket or a directory.
     #[error("{what} {path}: is a {kind}, not a regular file")]
@@ -101,7 +101,7 @@ fn kind_of(meta: &std::fs::Metadata) -> &'static str {
 
 /// Opens a regular file for reading, without blocking on a FIFO, after checking its type and size.
 pub fn open_regular(path: &Path, what: &'static str, limit: u64) -> Result<(File, u64), InputFileError> {
-    let io = |source| InputFileError::Io { what, path: path.to_owned(), source };
+    let io = |error| InputFileError::Io { what, path: path.to_owned(), error };
     let mut options = std::fs::OpenOptions::new();
     let _ = options.read(true);
     // Opening a FIFO for reading waits for a writer: open without blocking, then check the type
@@ -127,7 +127,7 @@ pub fn open_regular(path: &Path, what: &'static str, limit: u64) -> Result<(File
 pub fn read_regular(path: &Path, what: &'static str, limit: u64) -> Result<Vec<u8>, InputFileError> {
     let (file, size) = open_regular(path, what, limit)?;
     let mut bytes = Vec::with_capacity(size as usize);
-    let _ = file.take(limit + 1).read_to_end(&mut bytes).map_err(|source| InputFileError::Io { what, path: path.to_owned(), source })?;
+    let _ = file.take(limit + 1).read_to_end(&mut bytes).map_err(|error| InputFileError::Io { what, path: path.to_owned(), error })?;
     if bytes.len() as u64 > limit {
         return Err(InputFileError::TooLarge { what, path: path.to_owned(), size: bytes.len() as u64, limit });
     }
@@ -140,7 +140,7 @@ pub fn read_regular_text(path: &Path, what: &'static str, limit: u64) -> Result<
     let text = String::from_utf8(bytes).map_err(|e| InputFileError::Io {
         what,
         path: path.to_owned(),
-        source: std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 ({e})")),
+        error: std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8 ({e})")),
     })?;
     Ok(match text.strip_prefix('\u{feff}') {
         Some(rest) => rest.to_owned(),

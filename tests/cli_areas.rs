@@ -118,3 +118,28 @@ fn bad_input_is_one_line_and_exit_2() {
     std::fs::write(&txt, "x").unwrap();
     assert!(run_err(&["areas", txt.to_str().unwrap(), "--thickness", "0.01"]).contains("unsupported"));
 }
+
+/// `areas ... | head`: standard output closed before the report is written. The read end is
+/// closed before the command starts, so every write fails, whatever the timing.
+#[test]
+fn closed_standard_output_ends_without_a_panic() {
+    let obj = tmp("pipe.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let json = tmp("pipe.json");
+    for extra in [&[][..], &["--json", json.to_str().unwrap()][..]] {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let out = bin()
+            .args(["areas", obj.to_str().unwrap(), "--thickness", "0.01"])
+            .args(extra)
+            .stdout(writer)
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_ne!(out.status.code(), Some(101), "{extra:?}: {err}");
+        assert!(!err.contains("panicked"), "{extra:?}: {err}");
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: a report nobody could read is not a success: {err}");
+        assert!(err.contains("standard output") && err.trim_end().lines().count() == 1, "{extra:?}: {err}");
+    }
+}

@@ -155,3 +155,41 @@ fn bad_input_is_a_clear_error() {
     std::fs::write(&params, "thickness_collision:\n  ros__parameters:\n    missing_joint: reject\n").unwrap();
     err(bin().args(["check", "--params-file", params.to_str().unwrap(), "--joints", "elbow_joint=0"]).output().unwrap(), &["lacks joint"]);
 }
+
+/// A `package://` path that leaves its package: the reason is said once, and so is every part of
+/// the chain that leads to it (a `Display` that embeds its `#[source]` repeats under `{:#}`).
+#[test]
+fn package_escape_is_reported_once() {
+    let pkg = tmp("pkg");
+    std::fs::create_dir_all(&pkg).unwrap();
+    let params = tmp("escape_params.yaml");
+    std::fs::write(&params, format!("thickness_collision:\n  ros__parameters:\n    package_map: [\"pkg={}\"]\n", pkg.display())).unwrap();
+    let uri = "package://pkg/../../etc/passwd.stl";
+    let robot = tmp("escape.urdf");
+    std::fs::write(
+        &robot,
+        format!(
+            r#"<robot name="escape"><link name="base"/><link name="arm"><collision><geometry><mesh filename="{uri}"/></geometry></collision></link>
+<joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#
+        ),
+    )
+    .unwrap();
+    let out = bin().args(["check", "--params-file", params.to_str().unwrap(), "--robot", robot.to_str().unwrap(), "--joints", "j=0"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    err(out, &["escape.urdf", "link 'arm'", uri, "leaves its package"]);
+    let last = stderr.trim_end().lines().last().unwrap_or("");
+    for phrase in ["leaves its package", "cannot resolve", uri, "escape.urdf"] {
+        assert_eq!(last.matches(phrase).count(), 1, "{phrase:?} once in: {last}");
+    }
+}
+
+/// A file that cannot be opened: the OS's reason once.
+#[test]
+fn missing_states_file_is_reported_once() {
+    let missing = tmp("no_such_states.jsonl");
+    let out = bin().args(["check", "--states", missing.to_str().unwrap()]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    err(out, &["no_such_states.jsonl"]);
+    let last = stderr.trim_end().lines().last().unwrap_or("");
+    assert_eq!(last.matches("No such file").count(), 1, "{last}");
+}

@@ -27,9 +27,14 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     let cyclone = common::cyclone_loopback_file(&dir);
     let domain = 100 + std::process::id() % 50;
     let params = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/params.yaml");
+    // The node is renamed, and a parameters file applies by the node's full name (as rclcpp's).
+    let renamed = dir.join("params_tc_test.yaml");
+    let text = std::fs::read_to_string(&params).unwrap();
+    assert!(text.contains("/**/thickness_collision:"), "config/params.yaml changed its key");
+    std::fs::write(&renamed, text.replace("/**/thickness_collision:", "/**/tc_test:")).unwrap();
 
     let (mut node, mut out, banner) =
-        start_node(&["--ros-args", "-r", "__node:=tc_test", "--params-file", params.to_str().unwrap(), "-p", "check_motion:=false"], domain);
+        start_node(&["--ros-args", "-r", "__node:=tc_test", "--params-file", renamed.to_str().unwrap(), "-p", "check_motion:=false"], domain);
     assert!(banner.contains("/tc_test") && banner.contains("loopback only"), "{banner}");
 
     // The states, and check's answer for them.

@@ -77,6 +77,16 @@ fn params_file() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/params.yaml")
 }
 
+/// [`params_file`] keyed for the node renamed `tc_two` (a parameters file applies by the node's
+/// full name).
+fn renamed_params_file() -> std::path::PathBuf {
+    let text = std::fs::read_to_string(params_file()).unwrap();
+    assert!(text.contains("/**/thickness_collision:"), "config/params.yaml changed its key");
+    let out = scratch().join("params_tc_two.yaml");
+    std::fs::write(&out, text.replace("/**/thickness_collision:", "/**/tc_two:")).unwrap();
+    out
+}
+
 /// `check --json` on `states` with the node's parameters after the set to 0.2 m.
 fn reference(states: &[(Vec<&str>, Vec<f64>)]) -> Vec<Value> {
     let dir = scratch();
@@ -108,7 +118,7 @@ fn start_node_in_a(hosts: &TwoHosts, domain: u32, env: &[(&str, Option<&str>)]) 
             "-r",
             "__node:=tc_two",
             "--params-file",
-            params_file().to_str().unwrap(),
+            renamed_params_file().to_str().unwrap(),
             "-p",
             "check_motion:=false",
             "-p",

@@ -1,6 +1,7 @@
 //! `areas`: the cells of one mesh file.
 
 use anyhow::{bail, Context, Result};
+use std::io::Write;
 use std::path::PathBuf;
 use thickness_collision::math::Vector;
 use thickness_collision::mesh::{MeshTopology, TopologySettings};
@@ -31,29 +32,33 @@ pub fn areas(path: PathBuf, thickness: f64, side: Side, scale: &str, json: Optio
     let mesh = MeshTopology::build(&data.vertices, &data.triangles, &TopologySettings::default()).with_context(|| format!("mesh file {}", path.display()))?;
     let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() })?;
     let elapsed = started.elapsed();
-    print_report(&path, &area.report, thickness, side, elapsed);
+    // Written, not printed: println! panics when standard output is closed (`areas ... | head`);
+    // a write error ends the command with its message, as check's does.
+    let mut stdout = std::io::stdout().lock();
+    write_report(&mut stdout, &path, &area.report, thickness, side, elapsed).context("standard output")?;
     if let Some(out) = json {
         write_cells_json(&out, &area).with_context(|| format!("cannot write {}", out.display()))?;
-        println!("cells written to {}", out.display());
+        writeln!(stdout, "cells written to {}", out.display()).context("standard output")?;
     }
+    stdout.flush().context("standard output")?;
     Ok(())
 }
 
-fn print_report(path: &std::path::Path, r: &ThicknessReport, t: f64, side: Side, elapsed: std::time::Duration) {
+fn write_report(w: &mut impl Write, path: &std::path::Path, r: &ThicknessReport, t: f64, side: Side, elapsed: std::time::Duration) -> std::io::Result<()> {
     let topo = &r.topology;
-    println!("{}: {} triangles, {} vertices ({} after welding)", path.display(), topo.input_triangles, topo.input_vertices, topo.vertices);
-    println!("  thickness {t} m, side {}, built in {:.3} ms", side.as_str(), elapsed.as_secs_f64() * 1e3);
-    println!("  cells {}: tetrahedra {}, ratioed {}, prisms {}, diverging {}", r.cells, r.tetrahedra, r.ratioed, r.prisms, r.diverging);
-    println!("  skipped: degenerate {}, duplicate {}", r.degenerate_skipped, topo.duplicate_triangles);
-    println!(
+    writeln!(w, "{}: {} triangles, {} vertices ({} after welding)", path.display(), topo.input_triangles, topo.input_vertices, topo.vertices)?;
+    writeln!(w, "  thickness {t} m, side {}, built in {:.3} ms", side.as_str(), elapsed.as_secs_f64() * 1e3)?;
+    writeln!(w, "  cells {}: tetrahedra {}, ratioed {}, prisms {}, diverging {}", r.cells, r.tetrahedra, r.ratioed, r.prisms, r.diverging)?;
+    writeln!(w, "  skipped: degenerate {}, duplicate {}", r.degenerate_skipped, topo.duplicate_triangles)?;
+    writeln!(
+        w,
         "  edges: shared {}, boundary {}, non-manifold {}, inconsistent {}, folded {}",
         topo.shared_edges, r.boundary_edges, r.non_manifold_edges, r.inconsistent_edges, r.folded_edges
-    );
-    println!("  orientation: {} faces flipped; components closed {}, open {}", r.flipped_faces, topo.closed_components, topo.open_components);
+    )?;
+    writeln!(w, "  orientation: {} faces flipped; components closed {}, open {}", r.flipped_faces, topo.closed_components, topo.open_components)
 }
 
 fn write_cells_json(out: &std::path::Path, area: &ThicknessArea) -> Result<()> {
-    use std::io::Write;
     let file = std::fs::File::create(out)?;
     let mut w = std::io::BufWriter::new(file);
     w.write_all(b"{\"cells\": [")?;

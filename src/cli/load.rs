@@ -2,14 +2,28 @@
 
 use crate::ModelArgs;
 use anyhow::{bail, Result};
-use thickness_collision::model::Params;
+use std::path::PathBuf;
+use thickness_collision::model::{Params, DEFAULT_NODE_FQN};
 use thickness_collision::pipeline::Pipeline;
 
-/// The parameters file (or the defaults) with the command line's overrides applied.
+/// The parameters file (or the defaults) with the command line's overrides applied, read for
+/// the node `check` and `replay` stand for: `thickness_collision` in the root namespace.
 pub fn params(args: &ModelArgs) -> Result<Params> {
-    let mut params = match &args.params_file {
-        Some(path) => Params::from_file(path)?,
-        None => Params::default(),
+    params_for_node(args, &[], DEFAULT_NODE_FQN)
+}
+
+/// The CLI's `--params-file`, then `more` files, merged for the node `node_fqn` as rcl merges
+/// them (or the defaults without any), with the command line's overrides applied.
+pub fn params_for_node(args: &ModelArgs, more: &[PathBuf], node_fqn: &str) -> Result<Params> {
+    let files: Vec<PathBuf> = args.params_file.iter().cloned().chain(more.iter().cloned()).collect();
+    let mut params = if files.is_empty() {
+        Params::default()
+    } else {
+        let loaded = Params::from_files_for_node(&files, node_fqn)?;
+        for w in &loaded.warnings {
+            eprintln!("thickness_collision: warning: {w}");
+        }
+        loaded.params
     };
     if let Some(t) = args.thickness {
         if !thickness_collision::limits::is_length(t) {

@@ -2,16 +2,16 @@
 
 use crate::ModelArgs;
 use anyhow::Result;
-use thickness_collision::model::Params;
+use std::path::PathBuf;
+use thickness_collision::model::{node_fqn, Params};
 use thickness_collision::ros::{parse_ros_args, run as run_node, RunOptions};
 
 pub fn run(args: &ModelArgs, ros_args: &[String]) -> Result<()> {
     let ros_args = parse_ros_args(ros_args)?;
-    // --params-file after --ros-args counts like the CLI's own (the last file wins).
-    let mut model = args.clone();
-    if let Some(f) = ros_args.params_files.last() {
-        model.params_file = Some(f.into());
-    }
-    let params: Params = super::load::params(&model)?;
-    run_node(params, &RunOptions { ros_args, robot: model.robot.clone(), environment: model.environment.clone() })
+    // The CLI's --params-file, then each one after --ros-args, merged as rcl merges them, for
+    // this node's name: the sections a launch file writes for it (`/**`, its full name) apply.
+    let fqn = node_fqn(ros_args.namespace.as_deref(), ros_args.node_name.as_deref());
+    let more: Vec<PathBuf> = ros_args.params_files.iter().map(PathBuf::from).collect();
+    let params: Params = super::load::params_for_node(args, &more, &fqn)?;
+    run_node(params, &RunOptions { ros_args, robot: args.robot.clone(), environment: args.environment.clone() })
 }

@@ -92,7 +92,8 @@ pub fn parse_mesh(bytes: &[u8], path: &Path, scale: Vector) -> Result<MeshData, 
                 check_xml(bytes).map_err(|e| parse(e.to_string()))?;
                 check_collada(bytes).map_err(parse)?;
             }
-            if format == "obj" {
+            let normalised;
+            let bytes = if format == "obj" {
                 // Counted before mesh-loader allocates them.
                 let triangles: usize = bytes
                     .split(|&b| b == b'\n')
@@ -102,7 +103,11 @@ pub fn parse_mesh(bytes: &[u8], path: &Path, scale: Vector) -> Result<MeshData, 
                 if triangles > MAX_MESH_TRIANGLES {
                     return Err(parse(format!("{triangles} triangles, more than the {MAX_MESH_TRIANGLES} allowed")));
                 }
-            }
+                normalised = obj_positions_only(bytes).map_err(parse)?;
+                normalised.as_deref().unwrap_or(bytes)
+            } else {
+                bytes
+            };
             // Materials do not matter to collision: an OBJ's `mtllib` is never opened (it could
             // name a FIFO or a device).
             let no_materials = |_: &Path| -> std::io::Result<Vec<u8>> { Err(std::io::Error::other("material files are not read")) };
@@ -135,6 +140,69 @@ pub fn parse_mesh(bytes: &[u8], path: &Path, scale: Vector) -> Result<MeshData, 
         return scale_checked(data, path);
     }
     scale_mesh(&data, scale, path)
+}
+
+/// An OBJ whose faces reference positions only, or `None` when it already does; every face index
+/// checked first, naming its line.
+///
+/// Collision needs positions only, and mesh-loader refuses a file whose faces mix `v/vt/vn` with
+/// plain `v` (pybullet's `table_square/table.obj`): it reads texture coordinates for some corners
+/// and not others and reports "a position past the end of the file". It also turns an index 0 or
+/// one counting back past the first vertex into 4294967295 and the like. So each `f` line keeps
+/// the position of each corner (`7/3/2` -> `7`), and an index that is 0 or out of range is
+/// refused here with the index as written.
+fn obj_positions_only(bytes: &[u8]) -> Result<Option<Vec<u8>>, String> {
+    let is_space = |b: &u8| *b == b' ' || *b == b'\t';
+    let keyword = |line: &[u8], k: &[u8]| line.starts_with(k) && line.get(k.len()).is_some_and(is_space);
+    let lines = || bytes.split(|&b| b == b'\n').map(|l| l.strip_suffix(b"\r").unwrap_or(l));
+    // Positive indices may name a vertex defined further down (mesh-loader resolves them at the
+    // end of the group); negative ones count back from the vertices defined so far (OBJ spec).
+    let total = lines().filter(|l| keyword(l.trim_ascii_start(), b"v")).count();
+    let mut defined = 0usize;
+    let mut rewrite = false;
+    for (n, line) in lines().enumerate() {
+        let line = line.trim_ascii_start();
+        if keyword(line, b"v") {
+            defined += 1;
+        } else if keyword(line, b"f") {
+            for corner in line[1..].split(is_space).filter(|w| !w.is_empty()) {
+                let position = corner.split(|&b| b == b'/').next().unwrap_or_default();
+                rewrite |= position.len() != corner.len();
+                let text = String::from_utf8_lossy(position);
+                let at = |what: String| format!("line {}: face index {text}: {what}", n + 1);
+                let index: i64 =
+                    text.parse().map_err(|_| format!("line {}: face corner '{}' has no integer vertex index", n + 1, String::from_utf8_lossy(corner)))?;
+                if index == 0 {
+                    return Err(at("OBJ indices start at 1 (negative ones count back from the last vertex defined)".into()));
+                }
+                if index > 0 && index as u64 > total as u64 {
+                    return Err(at(format!("past the {total} vertices of the file (OBJ indices start at 1)")));
+                }
+                if index < 0 && index.unsigned_abs() > defined as u64 {
+                    return Err(at(format!("counts back past the first vertex: {defined} are defined before this line (-1 is the last)")));
+                }
+            }
+        }
+    }
+    if !rewrite {
+        return Ok(None);
+    }
+    let mut out = Vec::with_capacity(bytes.len());
+    for line in bytes.split_inclusive(|&b| b == b'\n') {
+        let start = line.len() - line.trim_ascii_start().len();
+        if !keyword(&line[start..], b"f") {
+            out.extend_from_slice(line);
+            continue;
+        }
+        out.extend_from_slice(b"f");
+        let body = line[start + 1..].trim_ascii_end();
+        for corner in body.split(is_space).filter(|w| !w.is_empty()) {
+            out.push(b' ');
+            out.extend_from_slice(corner.split(|&b| b == b'/').next().unwrap_or_default());
+        }
+        out.push(b'\n');
+    }
+    Ok(Some(out))
 }
 
 /// `data` scaled per axis (the winding reversed for a mirroring scale), with every vertex within
@@ -217,4 +285,53 @@ pub fn write_obj(path: &Path, vertices: &[Vector], triangles: &[[u32; 3]], comme
         writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
     }
     w.flush()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("tc_mesh_file_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir.join(name)
+    }
+
+    fn corners(data: &MeshData) -> Vec<[[Real; 3]; 3]> {
+        data.triangles.iter().map(|t| t.map(|i| data.vertices[i as usize].to_array())).collect()
+    }
+
+    #[test]
+    fn obj_with_mixed_faces_loads_every_corner() {
+        // Faces with and without texture coordinates and normals, as pybullet's
+        // table_square/table.obj has, a negative index and a quad.
+        let path = scratch("mixed.obj");
+        let text = "# mixed faces\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\n\
+                    f 1/1/1 2/2/1 3/3/1\nf 1 3 4\nf -1 1//1 2/2\r\nf 2/1 3/2 5/3 4";
+        std::fs::write(&path, text).unwrap();
+        let data = read_mesh(&path, Vector::ONE).unwrap();
+        let (a, b, c, d, e) = ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+        // What the file says, corner by corner: f 1 2 3; f 1 3 4; f 5 1 2 (-1 is the fifth);
+        // the quad 2 3 5 4 as the fan (2 3 5), (2 5 4).
+        assert_eq!(corners(&data), vec![[a, b, c], [a, c, d], [e, a, b], [b, c, e], [b, e, d]]);
+    }
+
+    #[test]
+    fn obj_face_index_errors_name_the_index_and_line() {
+        let refused = |name: &str, faces: &str| -> String {
+            let path = scratch(name);
+            std::fs::write(&path, format!("v 0 0 0\nv 1 0 0\nv 0 1 0\n{faces}")).unwrap();
+            let e = read_mesh(&path, Vector::ONE).unwrap_err().to_string();
+            assert!(e.contains(name) && !e.contains("4294967") && !e.contains('\n'), "{e}");
+            e
+        };
+        let e = refused("zero.obj", "f 1 2 3\nf 0 1 2\n");
+        assert!(e.contains("line 5: face index 0: OBJ indices start at 1 (negative ones count back"), "{e}");
+        let e = refused("minus100.obj", "f -100/1 1 2\n");
+        assert!(e.contains("line 4: face index -100: counts back past the first vertex: 3 are defined before this line"), "{e}");
+        let e = refused("past.obj", "f 1 2 4\n");
+        assert!(e.contains("line 4: face index 4: past the 3 vertices of the file"), "{e}");
+        let e = refused("word.obj", "f 1 x/1 2\n");
+        assert!(e.contains("line 4: face corner 'x/1' has no integer vertex index"), "{e}");
+    }
 }

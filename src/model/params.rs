@@ -1,9 +1,20 @@
 //! The parameters: one ROS 2 parameters YAML read by the CLI and the node alike.
 //!
-//! The file has the usual shape `<node>: ros__parameters: {...}` (the node `thickness_collision`,
-//! or `/**` for every node). Values are types ROS 2 parameters can hold: no maps, so per-item
-//! settings are parallel arrays (`thin_surfaces.patterns` with `.thickness` and `.side`).
-//! Unknown keys are an error naming the key.
+//! The file has the usual shape `<node>: ros__parameters: {...}`. Values are types ROS 2
+//! parameters can hold: no maps, so per-item settings are parallel arrays
+//! (`thin_surfaces.patterns` with `.thickness` and `.side`).
+//!
+//! Sections merge as rclcpp and rclpy merge them (`parameter_map_from`, over the
+//! `rcl_params_t` that rcl_yaml_param_parser builds): every section whose key matches the node's
+//! fully qualified name applies. A key without a leading `/` gets one (so `thickness_collision`
+//! is the node in the root namespace), `/**` stands for any number of names and `/*` for one
+//! (rclcpp turns the key into the regex `/*` -> `(/\w+)`). Sections apply in the order their keys
+//! first appear (rcl keeps one entry per key, in first-seen order, across all files); a later
+//! section's value for a parameter replaces an earlier one's.
+//!
+//! Unknown keys in a section that names this node are an error naming the key. A section whose
+//! node name is a wildcard (`/**`, `/robot1/*`) speaks to every node, so keys meant for other
+//! nodes are expected there: they are ignored with one warning.
 
 use crate::thickness::Side;
 use serde::{Deserialize, Serialize};
@@ -199,9 +210,19 @@ pub enum ParamsError {
     /// The YAML is malformed or has an unknown key or a wrong type.
     #[error("parameters file {0}: {1}")]
     Yaml(PathBuf, String),
-    /// The file has no section for this node.
-    #[error("parameters file {0} has no `thickness_collision:` or `/**:` section with `ros__parameters`")]
-    NoSection(PathBuf),
+    /// No section of the file (or files) applies to the node.
+    #[error(
+        "parameters file {files} has no section for node {node} (sections: {}); a key applies when it is the node's full name, a key without a leading / is in the root namespace, /** stands for any namespaces and * for one name",
+        show_keys(.keys)
+    )]
+    NoSection {
+        /// The file or files, as given.
+        files: String,
+        /// The node's fully qualified name.
+        node: String,
+        /// The section keys the files have.
+        keys: Vec<String>,
+    },
     /// A value is out of its domain.
     #[error("parameter {name}: {message}")]
     Invalid {
@@ -212,35 +233,57 @@ pub enum ParamsError {
     },
 }
 
+/// The node's fully qualified name when nothing renames it: `thickness_collision` in the root
+/// namespace (what `check` and `replay` read a parameters file for).
+pub const DEFAULT_NODE_FQN: &str = "/thickness_collision";
+
+/// The fully qualified name of the node after `-r __ns:=namespace` and `-r __node:=name` (each
+/// `None` when not given).
+pub fn node_fqn(namespace: Option<&str>, name: Option<&str>) -> String {
+    let ns = namespace.unwrap_or("/").trim_end_matches('/');
+    let slash = if ns.is_empty() || ns.starts_with('/') { "" } else { "/" };
+    format!("{slash}{ns}/{}", name.unwrap_or("thickness_collision"))
+}
+
+/// Parameters read from parameters files, with what the reader ignored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedParams {
+    /// The merged, validated parameters.
+    pub params: Params,
+    /// One line per thing ignored (keys of wildcard sections this node does not have).
+    pub warnings: Vec<String>,
+}
+
 impl Params {
-    /// Reads the node's section of a ROS 2 parameters file.
+    /// Reads a ROS 2 parameters file for the node [`DEFAULT_NODE_FQN`]; warnings are dropped
+    /// (see [`Params::from_files_for_node`]).
     pub fn from_file(path: &Path) -> Result<Params, ParamsError> {
-        let text = crate::limits::read_regular_text(path, "parameters file", crate::limits::MAX_PARAMS_BYTES)
-            .map_err(|e| ParamsError::Io(path.to_owned(), std::io::Error::other(e.to_string())))?;
-        Self::from_yaml(&text, path)
+        Self::from_files_for_node(&[path.to_owned()], DEFAULT_NODE_FQN).map(|l| l.params)
     }
 
-    /// Parses the node's section of a ROS 2 parameters YAML (`path` names it in errors).
+    /// Parses a ROS 2 parameters YAML for the node [`DEFAULT_NODE_FQN`] (`path` names it in
+    /// errors); warnings are dropped.
     pub fn from_yaml(text: &str, path: &Path) -> Result<Params, ParamsError> {
-        if text.len() as u64 > crate::limits::MAX_PARAMS_BYTES {
-            return Err(ParamsError::Yaml(path.to_owned(), format!("{} bytes, more than the {} allowed", text.len(), crate::limits::MAX_PARAMS_BYTES)));
+        Self::from_yaml_for_node(text, path, DEFAULT_NODE_FQN).map(|l| l.params)
+    }
+
+    /// Parses a ROS 2 parameters YAML for the node named `node_fqn` (`/ns/name`).
+    pub fn from_yaml_for_node(text: &str, path: &Path, node_fqn: &str) -> Result<LoadedParams, ParamsError> {
+        let mut sections = Vec::new();
+        read_sections(text, 0, path, &mut sections)?;
+        merge_sections(&sections, &[path.to_owned()], node_fqn)
+    }
+
+    /// Reads ROS 2 parameters files, in order, for the node named `node_fqn` (`/ns/name`): the
+    /// sections of all files that match the node merge as rcl merges several `--params-file`s.
+    pub fn from_files_for_node(paths: &[PathBuf], node_fqn: &str) -> Result<LoadedParams, ParamsError> {
+        let mut sections = Vec::new();
+        for (i, path) in paths.iter().enumerate() {
+            let text = crate::limits::read_regular_text(path, "parameters file", crate::limits::MAX_PARAMS_BYTES)
+                .map_err(|e| ParamsError::Io(path.to_owned(), std::io::Error::other(e.to_string())))?;
+            read_sections(&text, i, path, &mut sections)?;
         }
-        // A parameters file has no use for anchors and aliases; refusing them stops an alias
-        // bomb before the parser expands it.
-        if let Some((n, _)) = text.lines().enumerate().find(|(_, l)| has_alias(l)) {
-            return Err(ParamsError::Yaml(
-                path.to_owned(),
-                format!("line {}: YAML anchors and aliases (& and *) are not accepted in a parameters file", n + 1),
-            ));
-        }
-        let doc: serde_yaml_ng::Value = serde_yaml_ng::from_str(text).map_err(|e| ParamsError::Yaml(path.to_owned(), e.to_string()))?;
-        let section = ["thickness_collision", "/thickness_collision", "/**"]
-            .iter()
-            .find_map(|k| doc.get(k).and_then(|s| s.get("ros__parameters")))
-            .ok_or_else(|| ParamsError::NoSection(path.to_owned()))?;
-        let params: Params = serde_yaml_ng::from_value(section.clone()).map_err(|e| ParamsError::Yaml(path.to_owned(), e.to_string()))?;
-        params.validate()?;
-        Ok(params)
+        merge_sections(&sections, paths, node_fqn)
     }
 
     /// Checks every value's domain and the lengths of parallel arrays.
@@ -430,6 +473,228 @@ impl Params {
     }
 }
 
+/// One node entry of parameters files, as rcl keeps it: the key as written (nested keys joined
+/// with `/`), and its parameters by dotted name with the file each value came from, in
+/// first-seen order (a later value for the same name replaces the earlier one in place).
+struct Section {
+    key: String,
+    params: Vec<(String, serde_yaml_ng::Value, usize)>,
+}
+
+/// The node entries of one file (`file` is its index in the list read), added to `out`: a key
+/// already there (from an earlier file) takes the new values in its first place, as rcl's
+/// `find_node` does.
+fn read_sections(text: &str, file: usize, path: &Path, out: &mut Vec<Section>) -> Result<(), ParamsError> {
+    let yaml = |message: String| ParamsError::Yaml(path.to_owned(), message);
+    if text.len() as u64 > crate::limits::MAX_PARAMS_BYTES {
+        return Err(yaml(format!("{} bytes, more than the {} allowed", text.len(), crate::limits::MAX_PARAMS_BYTES)));
+    }
+    // A parameters file has no use for anchors and aliases; refusing them stops an alias
+    // bomb before the parser expands it.
+    if let Some((n, _)) = text.lines().enumerate().find(|(_, l)| has_alias(l)) {
+        return Err(yaml(format!("line {}: YAML anchors and aliases (& and *) are not accepted in a parameters file", n + 1)));
+    }
+    let doc: serde_yaml_ng::Value = serde_yaml_ng::from_str(text).map_err(|e| yaml(e.to_string()))?;
+    match doc {
+        serde_yaml_ng::Value::Null => Ok(()),
+        serde_yaml_ng::Value::Mapping(map) => read_node_map(&map, "", file, path, out),
+        _ => Err(yaml("the file is not a mapping of node names to `ros__parameters`".into())),
+    }
+}
+
+/// The YAML key as text; parameters files have string keys only.
+fn key_text(key: &serde_yaml_ng::Value, path: &Path) -> Result<String, ParamsError> {
+    match key {
+        serde_yaml_ng::Value::String(s) => Ok(s.clone()),
+        serde_yaml_ng::Value::Number(n) => Ok(n.to_string()),
+        serde_yaml_ng::Value::Bool(b) => Ok(b.to_string()),
+        other => Err(ParamsError::Yaml(path.to_owned(), format!("a key {other:?} is not a name"))),
+    }
+}
+
+/// Keys above `ros__parameters` name the node; nested ones join with `/` (rcl's node namespace
+/// tracker), so `robot1: {thickness_collision: {ros__parameters: ...}}` is the section
+/// `robot1/thickness_collision`.
+fn read_node_map(map: &serde_yaml_ng::Mapping, prefix: &str, file: usize, path: &Path, out: &mut Vec<Section>) -> Result<(), ParamsError> {
+    let yaml = |message: String| ParamsError::Yaml(path.to_owned(), message);
+    for (k, v) in map {
+        let k = key_text(k, path)?;
+        // rcl compares the key's first 15 bytes with ros__parameters, no more.
+        if k.starts_with("ros__parameters") {
+            if prefix.is_empty() {
+                return Err(yaml("`ros__parameters` has no node name above it".into()));
+            }
+            check_node_key(prefix).map_err(|m| yaml(format!("section `{prefix}`: {m}")))?;
+            let mut params = Vec::new();
+            match v {
+                serde_yaml_ng::Value::Mapping(m) => flatten_params(m, "", path, &mut params)?,
+                serde_yaml_ng::Value::Null => {}
+                _ => return Err(yaml(format!("section `{prefix}`: `ros__parameters` is not a mapping of parameter names to values"))),
+            }
+            let index = match out.iter().position(|s| s.key == prefix) {
+                Some(i) => i,
+                None => {
+                    out.push(Section { key: prefix.to_owned(), params: Vec::new() });
+                    out.len() - 1
+                }
+            };
+            let section = &mut out[index];
+            for (name, value) in params {
+                match section.params.iter_mut().find(|(n, _, _)| *n == name) {
+                    Some(slot) => *slot = (name, value, file),
+                    None => section.params.push((name, value, file)),
+                }
+            }
+            continue;
+        }
+        let key = if prefix.is_empty() { k.clone() } else { format!("{prefix}/{k}") };
+        match v {
+            serde_yaml_ng::Value::Mapping(m) => read_node_map(m, &key, file, path, out)?,
+            _ => return Err(yaml(format!("`{key}` has a value where a node name or `ros__parameters` was expected"))),
+        }
+    }
+    Ok(())
+}
+
+/// Nested parameter maps become dotted names, as rcl reads them (`thin_surfaces: {patterns: ..}`
+/// is `thin_surfaces.patterns`; so is a key written `thin_surfaces.patterns`).
+fn flatten_params(map: &serde_yaml_ng::Mapping, prefix: &str, path: &Path, out: &mut Vec<(String, serde_yaml_ng::Value)>) -> Result<(), ParamsError> {
+    for (k, v) in map {
+        let k = key_text(k, path)?;
+        let name = if prefix.is_empty() { k } else { format!("{prefix}.{k}") };
+        match v {
+            serde_yaml_ng::Value::Mapping(m) => flatten_params(m, &name, path, out)?,
+            v => out.push((name, v.clone())),
+        }
+    }
+    Ok(())
+}
+
+/// A section key rcl_yaml_param_parser accepts (its `__validate_name`): `/**`, or an optional
+/// namespace (`/**`, or names) and a node name (a name, or `*`). Names are letters, digits and
+/// `_`, not starting with a digit.
+fn check_node_key(key: &str) -> Result<(), String> {
+    if key == "/**" {
+        return Ok(());
+    }
+    let is_name = |t: &str| !t.is_empty() && t.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') && !t.starts_with(|c: char| c.is_ascii_digit());
+    let (namespace, node) = key.rsplit_once('/').unwrap_or(("", key));
+    if node != "*" && !is_name(node) {
+        return Err(format!("'{node}' is not a node name (letters, digits and _, not starting with a digit; or * for any)"));
+    }
+    let namespace = namespace.strip_prefix('/').unwrap_or(namespace);
+    if !namespace.is_empty() && namespace != "**" {
+        if let Some(t) = namespace.split('/').find(|t| !is_name(t)) {
+            return Err(format!(
+                "namespace '/{namespace}': '{t}' is not a name (letters, digits and _, not starting with a digit; the whole namespace may be /**)"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Whether the section key `key` applies to the node `node_fqn`: rclcpp's regex match of the
+/// key (a leading `/` added) with `/*` as `(/\w+)`, so `/**` is `(/\w+)*`, written over tokens.
+fn key_matches(key: &str, node_fqn: &str) -> bool {
+    fn tokens_match(pattern: &[&str], name: &[&str]) -> bool {
+        match pattern.split_first() {
+            None => name.is_empty(),
+            Some((&"**", rest)) => (0..=name.len()).any(|i| tokens_match(rest, &name[i..])),
+            Some((&"*", rest)) => !name.is_empty() && tokens_match(rest, &name[1..]),
+            Some((t, rest)) => name.first() == Some(t) && tokens_match(rest, &name[1..]),
+        }
+    }
+    let pattern: Vec<&str> = key.trim_start_matches('/').split('/').collect();
+    let name: Vec<&str> = node_fqn.trim_start_matches('/').split('/').collect();
+    tokens_match(&pattern, &name)
+}
+
+/// Whether a section speaks to every node (its node name is `*` or it is `/**`) rather than to
+/// this one by name.
+fn is_shared_key(key: &str) -> bool {
+    matches!(key.rsplit('/').next(), Some("*" | "**"))
+}
+
+fn show_keys(keys: &[String]) -> String {
+    if keys.is_empty() {
+        return "none".into();
+    }
+    keys.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ")
+}
+
+/// The sections that match `node_fqn`, applied in order into one [`Params`].
+fn merge_sections(sections: &[Section], paths: &[PathBuf], node_fqn: &str) -> Result<LoadedParams, ParamsError> {
+    let path_of = |file: usize| paths.get(file).cloned().unwrap_or_default();
+    let matching: Vec<&Section> = sections.iter().filter(|s| key_matches(&s.key, node_fqn)).collect();
+    if matching.is_empty() {
+        let files = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+        return Err(ParamsError::NoSection { files, node: node_fqn.to_owned(), keys: sections.iter().map(|s| s.key.clone()).collect() });
+    }
+    // Every leaf parameter and every group (`thin_surfaces`): a group given a scalar is ours,
+    // with a wrong type, and serde says so.
+    let mut known: Vec<String> = Params::default().flat().into_iter().map(|(n, _)| n).collect();
+    let groups: Vec<String> = known.iter().filter_map(|n| n.rsplit_once('.').map(|(g, _)| g.to_owned())).collect();
+    known.extend(groups);
+    let mut merged: Vec<(String, serde_yaml_ng::Value, usize)> = Vec::new();
+    let mut ignored: Vec<String> = Vec::new();
+    for section in matching {
+        let shared = is_shared_key(&section.key);
+        for (name, value, file) in &section.params {
+            if !known.contains(name) {
+                if shared {
+                    if !ignored.contains(name) {
+                        ignored.push(name.clone());
+                    }
+                    continue;
+                }
+                return Err(ParamsError::Yaml(
+                    path_of(*file),
+                    format!("section `{}`: unknown parameter `{name}` (`thickness_collision check --show-params` lists them all)", section.key),
+                ));
+            }
+            match merged.iter_mut().find(|(n, _, _)| n == name) {
+                Some(slot) => *slot = (name.clone(), value.clone(), *file),
+                None => merged.push((name.clone(), value.clone(), *file)),
+            }
+        }
+    }
+    let mut root = serde_yaml_ng::Mapping::new();
+    for (name, value, file) in &merged {
+        insert_dotted(&mut root, name, value.clone()).map_err(|m| ParamsError::Yaml(path_of(*file), m))?;
+    }
+    let first_file = merged.first().map_or_else(|| path_of(0), |(_, _, f)| path_of(*f));
+    let params: Params = serde_yaml_ng::from_value(serde_yaml_ng::Value::Mapping(root)).map_err(|e| ParamsError::Yaml(first_file, e.to_string()))?;
+    params.validate()?;
+    let mut warnings = Vec::new();
+    if !ignored.is_empty() {
+        warnings.push(format!(
+            "parameters for node {node_fqn}: ignored {} not known to thickness_collision from wildcard sections (/**, /ns/*): {}",
+            if ignored.len() == 1 { "a parameter" } else { "parameters" },
+            ignored.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+        ));
+    }
+    Ok(LoadedParams { params, warnings })
+}
+
+/// Puts `value` at the dotted `name` of `root`, making the groups on the way.
+fn insert_dotted(root: &mut serde_yaml_ng::Mapping, name: &str, value: serde_yaml_ng::Value) -> Result<(), String> {
+    let mut at = root;
+    let mut parts = name.split('.').peekable();
+    while let Some(part) = parts.next() {
+        let key = serde_yaml_ng::Value::String(part.to_owned());
+        if parts.peek().is_none() {
+            let _ = at.insert(key, value);
+            return Ok(());
+        }
+        let slot = at.entry(key).or_insert_with(|| serde_yaml_ng::Value::Mapping(serde_yaml_ng::Mapping::new()));
+        at = match slot {
+            serde_yaml_ng::Value::Mapping(m) => m,
+            _ => return Err(format!("parameter `{name}`: `{part}` is a value, not a group")),
+        };
+    }
+    Ok(())
+}
+
 /// Whether a YAML line has an anchor (`&name`) or an alias (`*name`) outside quotes and comments.
 fn has_alias(line: &str) -> bool {
     let mut quote = None;
@@ -545,6 +810,139 @@ mod tests {
         for v in [f64::NAN, f64::INFINITY] {
             says(Params { clearance_threshold: v, ..Params::default() }.validate().unwrap_err().to_string(), &format!("{v}"));
         }
+    }
+
+    fn for_node(text: &str, node: &str) -> Result<LoadedParams, ParamsError> {
+        Params::from_yaml_for_node(text, Path::new("p.yaml"), node)
+    }
+
+    fn thickness_for(text: &str, node: &str) -> Option<f64> {
+        for_node(text, node).ok().map(|l| l.params.default_thickness)
+    }
+
+    #[test]
+    fn node_names_from_ros_args() {
+        assert_eq!(node_fqn(None, None), DEFAULT_NODE_FQN);
+        assert_eq!(node_fqn(Some("/robot1"), None), "/robot1/thickness_collision");
+        assert_eq!(node_fqn(Some("/robot1/"), Some("arm_checker")), "/robot1/arm_checker");
+        assert_eq!(node_fqn(Some("robot1"), Some("tc")), "/robot1/tc");
+        assert_eq!(node_fqn(Some("/"), Some("tc")), "/tc");
+    }
+
+    #[test]
+    fn each_key_form_matches_as_rclcpp_does() {
+        let file = |key: &str| format!("{key}:\n  ros__parameters:\n    default_thickness: 0.05\n");
+        let root = "/thickness_collision";
+        let ns = "/robot1/thickness_collision";
+        let deep = "/a/b/thickness_collision";
+        let renamed = "/robot1/arm_checker";
+        // (key, nodes it applies to, nodes it does not)
+        let cases: &[(&str, &[&str], &[&str])] = &[
+            ("/**", &[root, ns, deep, renamed], &[]),
+            ("/**/thickness_collision", &[root, ns, deep], &[renamed]),
+            ("/robot1/thickness_collision", &[ns], &[root, deep, renamed]),
+            // A relative key gets a leading slash: the root namespace only.
+            ("thickness_collision", &[root], &[ns, deep, renamed]),
+            ("/thickness_collision", &[root], &[ns, deep, renamed]),
+            ("/robot1/*", &[ns, renamed], &[root, deep]),
+            ("/*", &[root], &[ns, deep, renamed]),
+            ("/**/*", &[root, ns, deep, renamed], &[]),
+            ("arm_checker", &[], &[root, ns, deep, renamed]),
+            ("robot1/arm_checker", &[renamed], &[root, ns, deep]),
+        ];
+        for (key, yes, no) in cases {
+            for node in *yes {
+                assert_eq!(thickness_for(&file(key), node), Some(0.05), "{key} should apply to {node}");
+            }
+            for node in *no {
+                let e = for_node(&file(key), node).unwrap_err().to_string();
+                assert!(e.contains("no section for node") && e.contains(node) && e.contains(&format!("`{key}`")) && !e.contains('\n'), "{key} for {node}: {e}");
+            }
+        }
+        // Nested keys are a namespace: robot1: {thickness_collision: ...}.
+        let nested = "robot1:\n  thickness_collision:\n    ros__parameters:\n      default_thickness: 0.07\n";
+        assert_eq!(thickness_for(nested, ns), Some(0.07));
+        assert!(for_node(nested, root).is_err());
+        // Keys rcl refuses are refused, naming the section.
+        for key in ["/*/thickness_collision", "/robot-1/thickness_collision", "/ro bot/x", "1node"] {
+            let e = for_node(&file(key), root).unwrap_err().to_string();
+            assert!(e.contains(&format!("section `{key}`")) && e.contains("p.yaml"), "{key}: {e}");
+        }
+    }
+
+    #[test]
+    fn sections_apply_in_order_of_first_appearance_later_wins() {
+        let two = |a: &str, b: &str| {
+            format!("{a}:\n  ros__parameters:\n    default_thickness: 0.01\n    marker_rate: 5.0\n{b}:\n  ros__parameters:\n    default_thickness: 0.03\n")
+        };
+        let p = for_node(&two("/**", "thickness_collision"), DEFAULT_NODE_FQN).unwrap().params;
+        assert_eq!((p.default_thickness, p.marker_rate), (0.03, 5.0), "the named section after /** wins; /** keeps what it alone sets");
+        // The other order: rclcpp has no preference for the exact name, the later section wins.
+        let p = for_node(&two("thickness_collision", "/**"), DEFAULT_NODE_FQN).unwrap().params;
+        assert_eq!((p.default_thickness, p.marker_rate), (0.03, 5.0));
+        let p = for_node(&two("/robot1/thickness_collision", "/**/thickness_collision"), "/robot1/thickness_collision").unwrap().params;
+        assert_eq!(p.default_thickness, 0.03);
+        // A section that does not match takes no part.
+        let p = for_node(&two("/**", "/robot2/thickness_collision"), "/robot1/thickness_collision").unwrap().params;
+        assert_eq!((p.default_thickness, p.marker_rate), (0.01, 5.0));
+        // Nested groups merge member by member.
+        let groups = "/**:\n  ros__parameters:\n    thin_surfaces:\n      patterns: [a]\n      thickness: [0.1]\nthickness_collision:\n  ros__parameters:\n    thin_surfaces.thickness: [0.2]\n";
+        let p = for_node(groups, DEFAULT_NODE_FQN).unwrap().params;
+        assert_eq!((p.thin_surfaces.patterns, p.thin_surfaces.thickness), (vec!["a".to_owned()], vec![0.2]));
+    }
+
+    #[test]
+    fn files_merge_with_keys_in_first_seen_order() {
+        let dir = std::env::temp_dir().join(format!("tc_params_files_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let a = dir.join("a.yaml");
+        let b = dir.join("b.yaml");
+        std::fs::write(&a, "/**:\n  ros__parameters:\n    default_thickness: 0.01\nthickness_collision:\n  ros__parameters:\n    marker_rate: 2.0\n").unwrap();
+        std::fs::write(&b, "/**:\n  ros__parameters:\n    default_thickness: 0.04\n    marker_rate: 3.0\n").unwrap();
+        let p = Params::from_files_for_node(&[a.clone(), b.clone()], DEFAULT_NODE_FQN).unwrap().params;
+        // b's /** joins a's /** entry, which comes before thickness_collision: marker_rate stays 2.
+        assert_eq!((p.default_thickness, p.marker_rate), (0.04, 2.0));
+        let p = Params::from_files_for_node(&[b, a], DEFAULT_NODE_FQN).unwrap().params;
+        assert_eq!((p.default_thickness, p.marker_rate), (0.01, 2.0));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn unknown_keys_are_refused_by_name_and_ignored_from_wildcards() {
+        let e = for_node("thickness_collision:\n  ros__parameters:\n    thin_surfaces:\n      patern: [a]\n", DEFAULT_NODE_FQN).unwrap_err().to_string();
+        assert!(e.contains("p.yaml") && e.contains("`thin_surfaces.patern`") && e.contains("section `thickness_collision`"), "{e}");
+        let e = for_node("/**/thickness_collision:\n  ros__parameters:\n    foo: 1\n", "/r/thickness_collision").unwrap_err().to_string();
+        assert!(e.contains("`foo`"), "{e}");
+        let shared =
+            "/**:\n  ros__parameters:\n    foo: 1\n    bar.baz: x\n    default_thickness: 0.05\n/robot1/*:\n  ros__parameters:\n    qos_overrides: 1\n";
+        let l = for_node(shared, "/robot1/thickness_collision").unwrap();
+        assert_eq!(l.params.default_thickness, 0.05);
+        assert_eq!(l.warnings.len(), 1, "{:?}", l.warnings);
+        assert!(l.warnings[0].contains("`foo`") && l.warnings[0].contains("`bar.baz`") && l.warnings[0].contains("`qos_overrides`"), "{:?}", l.warnings);
+        // A known key of ours with a wrong type in a wildcard section is still an error.
+        assert!(for_node("/**:\n  ros__parameters:\n    default_thickness: thick\n", DEFAULT_NODE_FQN).is_err());
+        // A file with sections for other nodes only keeps its clear error.
+        let e = for_node("other_node:\n  ros__parameters:\n    x: 1\n", DEFAULT_NODE_FQN).unwrap_err().to_string();
+        assert!(e.contains("no section for node /thickness_collision") && e.contains("`other_node`"), "{e}");
+        let e = for_node("", DEFAULT_NODE_FQN).unwrap_err().to_string();
+        assert!(e.contains("(sections: none)"), "{e}");
+        let e = for_node("thickness_collision: 3\n", DEFAULT_NODE_FQN).unwrap_err().to_string();
+        assert!(e.contains("`thickness_collision` has a value"), "{e}");
+    }
+
+    #[test]
+    fn launch_generated_file_honours_use_sim_time() {
+        // What `ros2 launch` writes for SetParameter(use_sim_time) beside a node's own section.
+        let text = "/**:\n  ros__parameters:\n    use_sim_time: true\nthickness_collision:\n  ros__parameters:\n    default_thickness: 0.03\n    thin_surfaces:\n      patterns: [\"guard_*\"]\n      thickness: [0.005]\n";
+        let l = for_node(text, DEFAULT_NODE_FQN).unwrap();
+        assert!(l.params.use_sim_time, "the /** value must not be dropped");
+        assert_eq!(l.params.default_thickness, 0.03);
+        assert_eq!(l.params.surface_settings("guard_sheet"), (0.005, Side::Back));
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        // The same file for a node in a namespace: the relative key is the root node's only.
+        let l = for_node(text, "/robot1/thickness_collision").unwrap();
+        assert!(l.params.use_sim_time);
+        assert_eq!(l.params.default_thickness, Params::default().default_thickness);
     }
 
     #[test]

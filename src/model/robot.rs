@@ -151,16 +151,16 @@ pub enum ModelError {
         /// What urdf-rs said.
         message: String,
     },
-    /// A mesh URI of a link does not resolve.
-    #[error("{file}: link '{link}': {source}")]
+    /// A mesh URI of a link does not resolve. (The package error is part of the message, not a
+    /// `source`: printed as a chain it would repeat itself.)
+    #[error("{file}: link '{link}': {error}")]
     Package {
         /// File.
         file: String,
         /// Link.
         link: String,
         /// Why.
-        #[source]
-        source: PackageError,
+        error: PackageError,
     },
     /// The text is unexpanded xacro (urdf-rs would read past its macros: a robot with nothing
     /// to check).
@@ -356,7 +356,7 @@ impl RobotModel {
                     urdf_rs::Geometry::Sphere { radius } => GeometrySpec::Sphere(positive("sphere radius", *radius)?),
                     urdf_rs::Geometry::Mesh { filename, scale } => {
                         let path =
-                            resolver.resolve(filename, base_dir).map_err(|source| ModelError::Package { file: file.into(), link: l.name.clone(), source })?;
+                            resolver.resolve(filename, base_dir).map_err(|error| ModelError::Package { file: file.into(), link: l.name.clone(), error })?;
                         let scale = scale.map_or([1.0; 3], |s| s.0);
                         if let Some(s) = scale.iter().find(|s| !(s.is_finite() && **s != 0.0 && s.abs() <= MAX_COORDINATE)) {
                             return Err(bad(&format!("mesh scale (allowed: non-zero, |s| <= {MAX_COORDINATE:e})"), *s));

@@ -406,7 +406,7 @@ impl Declared {
 /// A bag file opened only when it is a regular file (a FIFO would block, a device never end).
 fn open_bag_file(path: &Path) -> Result<File, BagError> {
     crate::limits::open_regular(path, "bag file", u64::MAX).map(|(f, _)| f).map_err(|e| match e {
-        crate::limits::InputFileError::Io { source, .. } => BagError::Io(path.to_owned(), source),
+        crate::limits::InputFileError::Io { error, .. } => BagError::Io(path.to_owned(), error),
         other => BagError::Io(path.to_owned(), std::io::Error::other(other.to_string())),
     })
 }

@@ -82,13 +82,34 @@ impl RateLimitedLog {
 /// The DDS participant: `ROS_DOMAIN_ID`, and the discovery range and static peers the
 /// environment asks for ([`DiscoverySettings`]).
 fn participant() -> Result<(DomainParticipant, u16, DiscoverySettings)> {
-    let domain: u16 = match std::env::var("ROS_DOMAIN_ID") {
-        Ok(v) if !v.trim().is_empty() => v.trim().parse().map_err(|_| anyhow!("ROS_DOMAIN_ID='{v}' is not a domain id (0-232)"))?,
-        _ => 0,
-    };
+    let domain = domain_id(std::env::var("ROS_DOMAIN_ID").ok().as_deref())?;
     let discovery = DiscoverySettings::from_env()?;
     let builder = discovery.apply(DomainParticipantBuilder::new(domain));
     Ok((builder.build().context("cannot create the DDS participant")?, domain, discovery))
+}
+
+/// The line a refused description is logged and diagnosed with: the topic once, then why. The
+/// error names its source (`/robot_description topic: ...`) when it comes from the text itself;
+/// that prefix is dropped, as the line already starts with the topic.
+fn refusal_line(topic: &str, source: &str, what_stays: &str, error: &str) -> String {
+    let error = error.replace('\n', " ");
+    let reason = error.strip_prefix(source).and_then(|r| r.strip_prefix(": ")).unwrap_or(&error);
+    format!("{topic} rejected, {what_stays}: {reason}")
+}
+
+/// The largest domain id: RTPS ports are `7400 + 250 * domain + ...`, and above 232 they pass
+/// 65535 and wrap (the limit the ROS 2 "Domain ID" article gives).
+const MAX_DOMAIN_ID: u16 = 232;
+
+/// `ROS_DOMAIN_ID` (`None` or blank: domain 0), refused outside 0-232.
+fn domain_id(value: Option<&str>) -> Result<u16> {
+    let Some(text) = value.map(str::trim).filter(|t| !t.is_empty()) else {
+        return Ok(0);
+    };
+    match text.parse::<u64>() {
+        Ok(d) if d <= u64::from(MAX_DOMAIN_ID) => Ok(d as u16),
+        _ => Err(anyhow!("ROS_DOMAIN_ID='{text}' is not a domain id: an integer from 0 to {MAX_DOMAIN_ID} is allowed")),
+    }
 }
 
 /// Reliable, transient local ("latched"), keep last `depth`: how `robot_description`,
@@ -580,8 +601,7 @@ impl NodeState {
                 self.publish_cells(io);
             }
             Err(e) => {
-                // One line whatever the error text holds.
-                let line = format!("{} rejected, keeping the current robot: {}", io.names.description, e.replace('\n', " "));
+                let line = refusal_line(&io.names.description, &source, "keeping the current robot", &e);
                 eprintln!("[ERROR] thickness_collision: {line}");
                 if self.log.pending.len() < 64 {
                     self.log.pending.push(line.clone());
@@ -612,7 +632,7 @@ impl NodeState {
                 self.description_error = None;
             }
             Err(e) => {
-                let line = format!("{} rejected, keeping the current collision matrix: {}", io.names.semantic, e.replace('\n', " "));
+                let line = refusal_line(&io.names.semantic, &source, "keeping the current collision matrix", &e);
                 eprintln!("[ERROR] thickness_collision: {line}");
                 if self.log.pending.len() < 64 {
                     self.log.pending.push(line.clone());
@@ -947,6 +967,29 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_refused_description_names_its_topic_once() {
+        let source = "/robot_description topic";
+        let line = refusal_line("/robot_description", source, "keeping the current robot", "/robot_description topic: malformed URDF: x\ny");
+        assert_eq!(line, "/robot_description rejected, keeping the current robot: malformed URDF: x y");
+        // An error about another file keeps its own prefix.
+        let line = refusal_line("/robot_description", source, "keeping the current robot", "env.urdf: link 'a': bad");
+        assert_eq!(line, "/robot_description rejected, keeping the current robot: env.urdf: link 'a': bad");
+    }
+
+    #[test]
+    fn domain_id_is_0_to_232() {
+        assert_eq!(domain_id(None).unwrap(), 0);
+        assert_eq!(domain_id(Some("  ")).unwrap(), 0);
+        assert_eq!(domain_id(Some("0")).unwrap(), 0);
+        assert_eq!(domain_id(Some(" 42 ")).unwrap(), 42);
+        assert_eq!(domain_id(Some("232")).unwrap(), 232);
+        for bad in ["233", "65535", "65536", "-1", "1.5", "one", "99999999999999999999999"] {
+            let e = domain_id(Some(bad)).unwrap_err().to_string();
+            assert!(e.contains("ROS_DOMAIN_ID") && e.contains(&format!("'{bad}'")) && e.contains("0 to 232") && !e.contains('\n'), "{bad}: {e}");
+        }
+    }
 
     #[test]
     fn ticks_come_and_a_missed_one_is_not_doubled() {

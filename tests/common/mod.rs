@@ -183,5 +183,5 @@ pub fn same_report(got: &serde_json::Value, want: &serde_json::Value, what: &str
 /// `missing_joint: last` nothing is reported before each has been received), stamped 1 ns.
 pub fn whole_arm_warm_up() -> serde_json::Value {
     let name = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
-    serde_json::json!({"name": name, "position": [0.0; 7], "stamp": 1})
+    serde_json::json!({"name": name, "position": vec![0.0; 7], "stamp": 1})
 }
