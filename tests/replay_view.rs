@@ -15,7 +15,8 @@ use thickness_collision::model::{bundled_config_dir, Params};
 
 const T0: i64 = 1_700_000_000_000_000_000;
 const STATES: usize = 300;
-const JOINTS: [&str; 6] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"];
+/// Every actuated joint of the bundled arm (missing_joint: last checks nothing before each came).
+const JOINTS: [&str; 7] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
@@ -40,7 +41,7 @@ fn path() -> Vec<Vec<f64>> {
     (0..STATES)
         .map(|k| {
             let s = k as f64 / 100.0 * 6.0;
-            vec![1.2 * (0.9 * s).sin(), 0.7 + 0.6 * (2.1 * s).sin(), 0.3 + 0.6 * (1.3 * s + 0.5).sin(), 0.8 * (1.7 * s).sin(), 0.5 * (1.1 * s).cos(), 0.0]
+            vec![1.2 * (0.9 * s).sin(), 0.7 + 0.6 * (2.1 * s).sin(), 0.3 + 0.6 * (1.3 * s + 0.5).sin(), 0.8 * (1.7 * s).sin(), 0.5 * (1.1 * s).cos(), 0.0, 0.0]
         })
         .collect()
 }
@@ -300,7 +301,7 @@ fn an_unwritable_plot_path_is_refused() {
     let bag = d.join("in");
     let _ = common::run_peer(
         "bag_tool.py",
-        &json!({"op": "write", "path": bag, "storage": "mcap", "messages": [{"t": T0, "stamp": T0, "name": JOINTS, "position": vec![0.0; 6]}]}),
+        &json!({"op": "write", "path": bag, "storage": "mcap", "messages": [{"t": T0, "stamp": T0, "name": JOINTS, "position": vec![0.0; 7]}]}),
     );
     let target = d.join("no_such_dir").join("t.svg");
     let out = bin().arg("replay").arg(&bag).arg("--plot").arg(&target).output().unwrap();
