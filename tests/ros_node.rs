@@ -64,6 +64,8 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     let mut service_states: Vec<Value> = states[..5].iter().map(|(n, p)| json!({"name": n, "position": p, "stamp": 7})).collect();
     service_states.insert(1, json!({"name": ["elbow_joint", "wrist_1_joint"], "position": [0.1, "NaN"], "stamp": 8}));
     service_states.insert(3, json!({"name": ["elbow_joint", "no_such_joint"], "position": [0.1, 0.2], "stamp": 9}));
+    // An empty state (no joint named) must not be checked at the zero pose.
+    service_states.insert(5, json!({"name": [], "position": [], "stamp": 10}));
     let request = json!({
         "domain": domain,
         "bad": bad,
@@ -122,14 +124,14 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
         assert_eq!(got["frame_id"], "world");
     }
     let service = answer["service"].as_array().unwrap();
-    assert_eq!(service.len(), 7, "check_states answers every state, bad ones in their slots");
+    assert_eq!(service.len(), 8, "check_states answers every state, bad ones in their slots");
     // Fail closed: the bad slots say in collision, with the cause.
-    for (slot, cause) in [(1, "non-finite"), (3, "no_such_joint")] {
+    for (slot, cause) in [(1, "non-finite"), (3, "no_such_joint"), (5, "names no joint")] {
         assert_eq!(service[slot]["in_collision"], true, "slot {slot}: {}", service[slot]);
         assert!(service[slot]["error"].as_str().unwrap().contains(cause), "slot {slot}: {}", service[slot]);
         assert!(service[slot]["contacts"].as_array().unwrap().is_empty());
     }
-    let good: Vec<&Value> = service.iter().enumerate().filter(|(k, _)| *k != 1 && *k != 3).map(|(_, v)| v).collect();
+    let good: Vec<&Value> = service.iter().enumerate().filter(|(k, _)| ![1, 3, 5].contains(k)).map(|(_, v)| v).collect();
     for (k, (got, want)) in good.iter().zip(&reference).enumerate() {
         common::same_report(got, want, &format!("service, state {k}"));
         assert_eq!(got["error"], "", "service, state {k}");
@@ -147,6 +149,8 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     // The bad messages were warned about and skipped, the node kept running.
     assert!(err.contains("2 positions") || err.contains("1 positions"), "lengths: {err}");
     assert!(err.contains("another_robots_joint") || err.contains("not a joint"), "unknown joint: {err}");
+    // A message of another robot's joints alone is skipped and counted, not checked at a pose.
+    assert!(rest.contains("not_our_robot"), "{rest}");
     eprintln!("node stderr:\n{err}\nnode stdout tail: {rest}");
 }
 

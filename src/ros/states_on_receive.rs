@@ -85,7 +85,9 @@ impl OnReceive {
         let more = waiting.len() == MAX_STATES_PER_TURN;
         if !waiting.is_empty() {
             if receiving_thread {
-                checking.state.stats.taken_on_receive += waiting.len() as u64;
+                // As `received` counts them: a sample that does not decode is counted
+                // `undecodable`, not received (counting it here made taken exceed received).
+                checking.state.stats.taken_on_receive += waiting.iter().filter(|m| m.is_ok()).count() as u64;
             }
             checking.state.on_joint_states(io, waiting);
         }
