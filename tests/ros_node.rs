@@ -268,7 +268,10 @@ fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
     let colliding = |v: &[Value]| v.iter().filter(|r| r["in_collision"] == true).count();
     assert!(colliding(&fat_ref) > colliding(&thin), "the fat forearm must collide more often");
 
-    let request = json!({"domain": domain, "robot_descriptions": ["<robot name='broken'><link name='a'></robot>", urdf],
+    // Refused in turn: malformed, nothing to check (visual geometry only), unexpanded xacro.
+    let visual_only = "<robot name='shown_only'><link name='a'><visual><geometry><box size='1 1 1'/></geometry></visual></link></robot>";
+    let xacro = "<robot name='x' xmlns:xacro='http://www.ros.org/wiki/xacro'><xacro:include filename='arm.xacro'/></robot>";
+    let request = json!({"domain": domain, "robot_descriptions": ["<robot name='broken'><link name='a'></robot>", visual_only, xacro, urdf],
         "states": states.iter().enumerate().map(|(k, (n, p))| json!({"name": n, "position": p, "stamp": k})).collect::<Vec<_>>(), "timeout": 30});
     let answer = common::run_cyclone_peer("dds_peer.py", &cyclone, &request.to_string().replace("\"NaN\"", "NaN"));
     let _ = Command::new("kill").args(["-TERM", &node.id().to_string()]).status();
@@ -278,6 +281,7 @@ fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
     let mut err = String::new();
     let _ = std::io::Read::read_to_string(&mut node.stderr.take().unwrap(), &mut err);
     assert!(err.contains("robot_description rejected") && err.contains("malformed"), "{err}");
+    assert!(err.contains("has no link to check") && err.contains("unexpanded xacro"), "{err}");
     assert!(rest.contains("robot from robot_description"), "{rest}");
     let reports = answer["reports"].as_array().unwrap();
     assert_eq!(reports.len(), fat_ref.len());
