@@ -61,8 +61,8 @@ pub enum BagError {
     /// The file cannot be read.
     #[error("cannot read bag {0}: {1}")]
     Io(PathBuf, std::io::Error),
-    /// Not a directory with metadata.yaml, an .mcap or a .db3 file.
-    #[error("{0}: unknown storage format (expected a rosbag2 directory with metadata.yaml, an .mcap file or a .db3 file)")]
+    /// Not a directory with metadata.yaml, an .mcap or a .db3 file (or one compressed as .zstd).
+    #[error("{0}: unknown storage format (expected a rosbag2 directory with metadata.yaml, an .mcap file or a .db3 file, or such a file compressed as .zstd)")]
     UnknownFormat(PathBuf),
     /// metadata.yaml is malformed or names a storage this reader does not know.
     #[error("{0}/metadata.yaml: {1}")]
@@ -1109,6 +1109,125 @@ mod tests {
         std::fs::write(&bad, b"this is not a database, it only has the name of one").unwrap();
         let e = open_bag(&bad).unwrap_err().to_string();
         assert!(e.contains("bad.db3"), "{e}");
+    }
+
+    /// An MCAP file with the messages of `bytes`, each payload passed through `payload`.
+    fn remap_mcap(bytes: &[u8], payload: impl Fn(&[u8]) -> Vec<u8>) -> Vec<u8> {
+        let mut buf = Cursor::new(Vec::new());
+        {
+            let mut w = mcap::WriteOptions::new().compression(Some(mcap::Compression::Zstd)).create(&mut buf).unwrap();
+            for m in mcap::MessageStream::new(bytes).unwrap() {
+                let m = m.unwrap();
+                w.write(&mcap::Message { data: std::borrow::Cow::Owned(payload(&m.data)), ..m }).unwrap();
+            }
+            let _ = w.finish().unwrap();
+        }
+        buf.into_inner()
+    }
+
+    fn compressed_metadata(dir: &Path, storage: &str, files: &[&str], mode: &str, format: &str) {
+        metadata(dir, storage, files);
+        let mut text = std::fs::read_to_string(dir.join("metadata.yaml")).unwrap();
+        text += &format!("  compression_format: {format}\n  compression_mode: {mode}\n");
+        std::fs::write(dir.join("metadata.yaml"), text).unwrap();
+    }
+
+    /// The scratch folders of this process in the temporary folder.
+    fn scratch_folders() -> usize {
+        let prefix = format!("thickness_collision_bag_{}_", std::process::id());
+        std::fs::read_dir(std::env::temp_dir()).unwrap().filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().starts_with(&prefix)).count()
+    }
+
+    #[test]
+    fn compressed_directories_read_like_plain_ones() {
+        let d = scratch("compressed");
+        let plain = write_mcap(mcap::WriteOptions::new(), 300);
+        let want = reference(&plain);
+        let zstd1 = |b: &[u8]| zstd::bulk::compress(b, 1).unwrap();
+
+        // Message mode, MCAP.
+        std::fs::write(d.join("bag_0.mcap"), remap_mcap(&plain, zstd1)).unwrap();
+        compressed_metadata(&d, "mcap", &["bag_0.mcap"], "MESSAGE", "zstd");
+        let (msgs, err) = all(open_bag(&d).unwrap());
+        assert!(err.is_none(), "{err:?}");
+        same(&msgs, &want);
+        // Without the metadata the payloads are what is stored: zstd frames.
+        let (raw, _) = all(open_bag(&d.join("bag_0.mcap")).unwrap());
+        assert!(raw.iter().all(|m| super::super::bag_compression::looks_like_zstd(&m.data)));
+
+        // A payload that declares 2^40 bytes: an error naming the file, the message and the size.
+        let mut lying = vec![0x28, 0xb5, 0x2f, 0xfd, 0xe0];
+        lying.extend_from_slice(&(1u64 << 40).to_le_bytes());
+        let n = std::cell::Cell::new(0);
+        std::fs::write(
+            d.join("bag_0.mcap"),
+            remap_mcap(&plain, |b| {
+                n.set(n.get() + 1);
+                if n.get() == 7 {
+                    lying.clone()
+                } else {
+                    zstd1(b)
+                }
+            }),
+        )
+        .unwrap();
+        let (msgs, err) = all(open_bag(&d).unwrap());
+        let err = err.expect("refused").to_string();
+        assert_eq!(msgs.len(), 6);
+        assert!(err.contains("bag_0.mcap: message 7 of the file") && err.contains("1099511627776 bytes") && err.contains("limit of 268435456"), "{err}");
+
+        // Message mode, sqlite3.
+        let rows: Vec<(i64, i64, Vec<u8>)> = (0..200).map(|k| (1 + (k % 2), k, payload(k as usize))).collect();
+        let packed: Vec<(i64, i64, Vec<u8>)> = rows.iter().map(|(t, k, p)| (*t, *k, zstd1(p))).collect();
+        write_db3(&d.join("bag_0.db3"), &packed);
+        compressed_metadata(&d, "sqlite3", &["bag_0.db3"], "message", "zstd");
+        let (msgs, err) = all(open_bag(&d).unwrap());
+        assert!(err.is_none(), "{err:?}");
+        assert_eq!(msgs.iter().map(|m| m.data.clone()).collect::<Vec<_>>(), rows.iter().map(|r| r.2.clone()).collect::<Vec<_>>());
+        let r = open_bag(&d).unwrap();
+        assert_eq!(r.encodings(), [("/joint_states".to_owned(), "cdr".to_owned()), ("/tf".to_owned(), "cdr".to_owned())]);
+
+        // File mode: two files, each compressed whole; a scratch folder while open, none after.
+        let second = write_mcap(mcap::WriteOptions::new().compression(Some(mcap::Compression::Lz4)), 50);
+        std::fs::write(d.join("bag_0.mcap.zstd"), zstd1(&plain)).unwrap();
+        std::fs::write(d.join("bag_1.mcap.zstd"), zstd1(&second)).unwrap();
+        compressed_metadata(&d, "mcap", &["bag_0.mcap.zstd", "bag_1.mcap.zstd"], "FILE", "zstd");
+        let r = open_bag(&d).unwrap();
+        assert_eq!(scratch_folders(), 1);
+        let (msgs, err) = all(r);
+        assert!(err.is_none(), "{err:?}");
+        let mut both = want.clone();
+        both.extend(reference(&second));
+        same(&msgs, &both);
+        assert_eq!(scratch_folders(), 0, "removed with the reader");
+        // A corrupt file inside: named as the compressed file, decompressed.
+        let mut cut = plain.clone();
+        cut.truncate(plain.len() * 6 / 10);
+        std::fs::write(d.join("bag_1.mcap.zstd"), zstd1(&cut)).unwrap();
+        let (_, err) = all(open_bag(&d).unwrap());
+        let err = err.expect("truncated").to_string();
+        assert!(err.contains("bag_1.mcap.zstd (decompressed): corrupt or truncated MCAP"), "{err}");
+        // Not zstd at all: refused at open, nothing left behind.
+        std::fs::write(d.join("bag_1.mcap.zstd"), &second).unwrap();
+        let err = open_bag(&d).unwrap_err().to_string();
+        assert!(err.contains("bag_1.mcap.zstd: is not a zstd file"), "{err}");
+        assert_eq!(scratch_folders(), 0, "removed on error");
+        // Missing.
+        compressed_metadata(&d, "mcap", &["bag_0.mcap.zstd", "gone.mcap.zstd"], "FILE", "zstd");
+        assert!(open_bag(&d).unwrap_err().to_string().contains("gone.mcap.zstd"));
+        // A bare .zstd file, and one whose inner name is not a storage.
+        let (msgs, err) = all(open_bag(&d.join("bag_0.mcap.zstd")).unwrap());
+        assert!(err.is_none());
+        same(&msgs, &want);
+        std::fs::write(d.join("notes.txt.zstd"), zstd1(b"x")).unwrap();
+        assert!(open_bag(&d.join("notes.txt.zstd")).unwrap_err().to_string().contains("unknown storage format"));
+
+        // Unknown formats and modes: refused at open, naming metadata.yaml and the value.
+        for (mode, format, says) in [("MESSAGE", "lz4", "compression_format 'lz4'"), ("CHUNK", "zstd", "compression_mode 'CHUNK'")] {
+            compressed_metadata(&d, "mcap", &["bag_0.mcap"], mode, format);
+            let err = open_bag(&d).unwrap_err().to_string();
+            assert!(err.contains("metadata.yaml") && err.contains(says), "{err}");
+        }
     }
 
     /// A reader can move to another thread.
