@@ -759,7 +759,8 @@ impl Drop for SqliteStream {
 
 /// The reader thread: every row in timestamp order. Ok(false) when the iterator went away.
 fn send_rows(db: &rusqlite::Connection, tx: &SyncSender<Row>, flow: &Flow) -> Result<bool, String> {
-    let topics: HashMap<i64, (String, String)> = sqlite_topic_rows(db).map_err(|e| e.to_string())?.into_iter().map(|(id, name, ty, _)| (id, (name, ty))).collect();
+    let topics: HashMap<i64, (String, String)> =
+        sqlite_topic_rows(db).map_err(|e| e.to_string())?.into_iter().map(|(id, name, ty, _)| (id, (name, ty))).collect();
     let mut stmt = db.prepare("SELECT topic_id, timestamp, length(data), data FROM messages ORDER BY timestamp, id").map_err(|e| e.to_string())?;
     let mut rows = stmt.query([]).map_err(|e| e.to_string())?;
     while let Some(row) = rows.next().map_err(|e| e.to_string())? {
