@@ -202,6 +202,11 @@ fn inputs_without_a_state_to_check_exit_2() {
         assert!(String::from_utf8_lossy(&out.stdout).contains("4 x undecodable"));
     }
 
+    let one = d.join("one_junk");
+    write_bag(&one, "mcap", &junk[..1]);
+    let e = refused(&replay(&one, &d, "one_junk", &[]).1);
+    assert!(e.contains("the one message on /joint_states") && e.contains("does not decode as CDR"), "{e}");
+
     // The topic is declared but has no messages: refused, naming the topics that have some.
     let tf_only = d.join("tf_only");
     write_bag(&tf_only, "sqlite3", &[json!({"t": T0, "stamp": T0, "transforms": []})]);

@@ -335,25 +335,35 @@ impl InputCount {
             let have = if have.is_empty() { "no messages at all".to_owned() } else { format!("messages on {}", have.join(", ")) };
             return Some(format!("bag {} has no messages on topic {topic}, so no state to check (it has {have})", bag.display()));
         }
+        // "none of the 1 messages decodes" reads badly; one message gets its own wording.
+        let subject = |n: u64| if n == 1 { "the one message".to_owned() } else { format!("none of the {n} messages") };
+        let verb = |n: u64, one: &'static str, many: &'static str| if n == 1 { one } else { many };
         if self.in_window == 0 {
             let (a, b) = self.span.unwrap_or_default();
             let flag = |f: &str, v: Option<f64>| v.map_or(String::new(), |v| format!(" {f} {v}"));
             return Some(format!(
-                "none of the {on_topic} messages on {topic} in bag {} is inside{}{} (they are {a:.3} to {b:.3} s after the bag's first message)",
+                "{} on {topic} in bag {} {}{}{} (logged {a:.3} to {b:.3} s after the bag's first message)",
+                subject(on_topic),
                 bag.display(),
+                verb(on_topic, "is not inside", "is inside"),
                 flag("--start", start),
                 flag("--end", end)
             ));
         }
         let hint = if self.zstd_frames == self.in_window {
-            "; they are zstd frames: a message-compressed bag read without its metadata.yaml (replay the bag's directory)"
+            verb(
+                self.in_window,
+                "; it is a zstd frame: a message-compressed bag read without its metadata.yaml (replay the bag's directory)",
+                "; they are zstd frames: a message-compressed bag read without its metadata.yaml (replay the bag's directory)",
+            )
         } else {
             ""
         };
         Some(format!(
-            "none of the {} messages on {topic} in bag {} decodes as CDR {expected} (the first: {}){hint}",
-            self.in_window,
+            "{} on {topic} in bag {} {} as CDR {expected} (the first error: {}){hint}",
+            subject(self.in_window),
             bag.display(),
+            verb(self.in_window, "does not decode", "decodes"),
             self.first_error.as_deref().unwrap_or("?")
         ))
     }
