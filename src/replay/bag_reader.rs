@@ -13,7 +13,7 @@
 //! - Compressed bags (`compression_mode` `message` or `file`, zstd; a bare `.zstd` file) are
 //!   decompressed as [`super::bag_compression`] describes, within the same bounds.
 
-use super::bag_compression::{compression_from_metadata, decompress_message, Compression, Scratch, MAX_FILE_BYTES};
+use super::bag_compression::{compression_from_metadata, decompress_message, message_context, Compression, MessageContext, Scratch, MAX_FILE_BYTES};
 use mcap::read::ChannelAccumulator;
 use mcap::records::{op, Record};
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -130,6 +130,8 @@ pub struct BagReader {
     current: Option<Source>,
     /// Messages of the current file yielded so far.
     read_in_file: usize,
+    /// Message compression's zstd context, made at the first message.
+    message_context: Option<MessageContext>,
     topics: Vec<(String, String)>,
     encodings: Vec<(String, String)>,
     topics_fault: Option<BagError>,
@@ -213,13 +215,15 @@ impl Iterator for BagReader {
             };
             let shown = || self.files.get(self.next_file - 1).map(|f| f.shown.clone()).unwrap_or_default();
             let item = match item {
-                Some(Ok(m)) if self.compression == Compression::Message => Some(match decompress_message(&m.data, MAX_RECORD_BYTES) {
-                    Ok(data) => Ok(BagMessage { data, ..m }),
-                    Err(e) => Err(BagError::Decompress(
-                        shown(),
-                        format!("message {} of the file (at {} ns on {}) {e} (compression_mode message, zstd)", self.read_in_file + 1, m.log_time, m.topic),
-                    )),
-                }),
+                Some(Ok(m)) if self.compression == Compression::Message => {
+                    Some(match message_context_of(&mut self.message_context).and_then(|c| decompress_message(&m.data, MAX_RECORD_BYTES, c)) {
+                        Ok(data) => Ok(BagMessage { data, ..m }),
+                        Err(e) => Err(BagError::Decompress(
+                            shown(),
+                            format!("message {} of the file (at {} ns on {}) {e} (compression_mode message, zstd)", self.read_in_file + 1, m.log_time, m.topic),
+                        )),
+                    })
+                }
                 other => other,
             };
             match item {
@@ -240,6 +244,13 @@ impl Iterator for BagReader {
 }
 
 impl std::iter::FusedIterator for BagReader {}
+
+fn message_context_of(slot: &mut Option<MessageContext>) -> Result<&mut MessageContext, String> {
+    match slot {
+        Some(c) => Ok(c),
+        None => Ok(slot.insert(message_context()?)),
+    }
+}
 
 /// Opens a bag: checks the files, reads the topics, reads no messages (iterate for those). A
 /// file-compressed bag is decompressed here, every file, into the temporary folder.
@@ -330,7 +341,20 @@ pub fn open_bag(path: &Path) -> Result<BagReader, BagError> {
             break;
         }
     }
-    Ok(BagReader { storage, compression, files, next_file: 0, current: None, read_in_file: 0, topics, encodings, topics_fault, done: false, _scratch: scratch })
+    Ok(BagReader {
+        storage,
+        compression,
+        files,
+        next_file: 0,
+        current: None,
+        read_in_file: 0,
+        message_context: None,
+        topics,
+        encodings,
+        topics_fault,
+        done: false,
+        _scratch: scratch,
+    })
 }
 
 // ---------------------------------------------------------------------------------------------
