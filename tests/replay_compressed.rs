@@ -1,8 +1,9 @@
 //! Issue 30: compressed bags and inputs with nothing to check. rosbags writes plain bags of the
 //! bundled arm's joint states (MCAP and sqlite3); `tests/peers/bag_compress.py` compresses them as
 //! `ros2 bag record --compression-format zstd --compression-mode message|file` does (zstandard).
-//! Replay of each compressed bag must give the plain bag's reports byte for byte; rosbags' own
-//! reader must read the compressed bags to the plain bag's messages (they are the format it knows);
+//! Replay of each compressed bag, and of the same bag compressed by rosbags' own writer, must give
+//! the plain bag's reports byte for byte; rosbags' reader must read the hand-compressed bags to the
+//! plain bag's messages (they are the format it knows);
 //! and every input without a state to check must exit 2 with one line that says why.
 
 mod common;
@@ -131,6 +132,16 @@ fn message_and_file_compressed_bags_replay_like_the_plain_ones() {
             assert!(out.status.success(), "{what}: {}", String::from_utf8_lossy(&out.stderr));
             same_lines(&got, &want, &what);
             assert_eq!(left, 0, "{what}: the decompressed copies are removed");
+            // The same bag compressed by rosbags' writer: lower-case mode, and in file mode a
+            // frame that does not declare its size.
+            let by_rosbags = d.join(format!("rosbags_{mode}_{storage}"));
+            let _ = peer("rosbags", &plain, json!({"out": by_rosbags, "mode": mode}));
+            let meta = std::fs::read_to_string(by_rosbags.join("metadata.yaml")).unwrap();
+            assert!(meta.contains(&format!("compression_mode: {mode}\n")), "{meta}");
+            let (got, out, left) = replay(&by_rosbags, &d, &format!("rosbags_{mode}_{storage}"), &[]);
+            assert!(out.status.success(), "{what}, rosbags' writer: {}", String::from_utf8_lossy(&out.stderr));
+            same_lines(&got, &want, &format!("{what}, rosbags' writer"));
+            assert_eq!(left, 0);
             if mode == "file" {
                 let zst = storage_file(&bag, &format!("{ext}.zstd"));
                 assert!(std::fs::metadata(&zst).unwrap().len() < plain_size, "{what}: compressed");

@@ -9,6 +9,9 @@ zstandard bindings of the zstd library rosbag2 links:
   `relative_file_paths` and `files[].path` name the new files.
 
 Both set `compression_format: zstd` and `compression_mode: MESSAGE` or `FILE` in metadata.yaml.
+"rosbags" writes a second copy with rosbags' own Writer and its compression (backports.zstd; in
+file mode a streamed frame without a declared size, `compression_mode` in lower case): another
+writer of the same format.
 Other ops: "encoding" rewrites one MCAP topic's channel message_encoding (a ROS 1 channel);
 "format" sets compression_format alone; "read" lists what rosbags' Reader gets from a bag (its
 own decompression), to show the compressed bags are the format rosbags knows.
@@ -111,6 +114,21 @@ def fmt(req):
     return {"ok": True}
 
 
+def rosbags_copy(req):
+    from rosbags.rosbag2 import CompressionFormat, CompressionMode, Reader, StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+    store = get_typestore(Stores.ROS2_JAZZY)
+    with Reader(req["path"]) as r:
+        plugin = StoragePlugin.MCAP if any(Path(req["path"]).glob("*.mcap")) else StoragePlugin.SQLITE3
+        w = Writer(req["out"], version=8, storage_plugin=plugin)
+        w.set_compression(CompressionMode.FILE if req["mode"] == "file" else CompressionMode.MESSAGE, CompressionFormat.ZSTD)
+        with w:
+            conns = {c.id: w.add_connection(c.topic, c.msgtype, typestore=store) for c in r.connections}
+            for conn, t, raw in r.messages():
+                w.write(conns[conn.id], t, bytes(raw))
+    return {"ok": True}
+
+
 def read(req):
     from rosbags.rosbag2 import Reader
     out = []
@@ -121,4 +139,4 @@ def read(req):
 
 
 req = json.load(sys.stdin)
-json.dump({"message": message, "file": file, "encoding": encoding, "format": fmt, "read": read}[req["op"]](req), sys.stdout)
+json.dump({"message": message, "file": file, "rosbags": rosbags_copy, "encoding": encoding, "format": fmt, "read": read}[req["op"]](req), sys.stdout)
