@@ -213,7 +213,7 @@ impl Iterator for BagReader {
                 Some(Source::Sqlite(s)) => s.next(),
                 None => None,
             };
-            let shown = || self.files.get(self.next_file - 1).map(|f| f.shown.clone()).unwrap_or_default();
+            let shown = || self.files.get(self.next_file.saturating_sub(1)).map(|f| f.shown.clone()).unwrap_or_default();
             let item = match item {
                 Some(Ok(m)) if self.compression == Compression::Message => {
                     Some(match message_context_of(&mut self.message_context).and_then(|c| decompress_message(&m.data, MAX_RECORD_BYTES, c)) {
@@ -311,7 +311,12 @@ pub fn open_bag(path: &Path) -> Result<BagReader, BagError> {
             }
             let s = match &mut scratch {
                 Some(s) => s,
-                None => scratch.insert(Scratch::create(&std::env::temp_dir()).map_err(|e| BagError::Io(std::env::temp_dir(), e))?),
+                None => {
+                    let tmp = std::env::temp_dir();
+                    let s = Scratch::create(&tmp)
+                        .map_err(|e| BagError::Decompress(f.clone(), format!("cannot make a folder in {} to decompress it into: {e}", tmp.display())))?;
+                    scratch.insert(s)
+                }
             };
             let read = s.decompress(&f, MAX_FILE_BYTES).map_err(|e| BagError::Decompress(f.clone(), e))?;
             Ok(BagFile { read, shown: PathBuf::from(format!("{} (decompressed)", f.display())) })
