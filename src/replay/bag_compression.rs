@@ -108,7 +108,8 @@ impl Scratch {
         static NEXT: AtomicUsize = AtomicUsize::new(0);
         loop {
             let dir = base.join(format!("thickness_collision_bag_{}_{}", std::process::id(), NEXT.fetch_add(1, Ordering::Relaxed)));
-            match std::fs::create_dir(&dir) {
+            // Private (0700): the temporary folder is shared, a recording need not be.
+            match std::os::unix::fs::DirBuilderExt::mode(&mut std::fs::DirBuilder::new(), 0o700).create(&dir) {
                 Ok(()) => return Ok(Scratch { dir, written: 0 }),
                 // Left by an earlier process with the same id that was killed: try the next name.
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
@@ -285,6 +286,8 @@ mod tests {
         {
             let mut s = Scratch::create(&base).unwrap();
             scratch_dir = s.dir.clone();
+            use std::os::unix::fs::PermissionsExt;
+            assert_eq!(std::fs::metadata(&scratch_dir).unwrap().permissions().mode() & 0o777, 0o700);
             let a = s.decompress(&src, 1 << 30).unwrap();
             assert_eq!(a.file_name().unwrap(), "bag_0.mcap");
             assert_eq!(std::fs::read(&a).unwrap(), content);
