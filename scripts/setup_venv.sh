@@ -24,6 +24,7 @@ packages=(
     "mcap-ros2-support==0.6.0"  # a second, independent MCAP/ROS 2 reader
     "yourdfpy==0.0.60"          # an independent URDF parser and FK
     "xacro==2.1.1"              # ROS's xacro, to expand MoveIt's .xacro configs as users do
+    "zstandard==0.25.0"         # zstd bindings: compresses bags as rosbag2 does (tests/replay_compressed.rs)
 )
 stamp="$venv/.tc-packages"
 want="$("$python" -c 'import sys; print(sys.version.split()[0])') ${packages[*]}"
@@ -50,12 +51,12 @@ else
     # its metadata and its share folder).
     "$venv/bin/python" - >&2 <<'EOF'
 import importlib.metadata as md, os, site
-import coal, fcl, numpy, rosbags, cyclonedds, mcap_ros2, yourdfpy, xacro
+import coal, fcl, numpy, rosbags, cyclonedds, mcap_ros2, yourdfpy, xacro, zstandard
 share = [os.path.join(p, "cmeel.prefix", "share", "example-robot-data") for p in site.getsitepackages()]
 assert any(os.path.isdir(s) for s in share), f"example-robot-data share folder missing: {share}"
 print("setup_venv: " + ", ".join(f"{p} {md.version(p)}" for p in [
     "numpy", "coal", "python-fcl", "rosbags", "cyclonedds", "example-robot-data",
-    "mcap-ros2-support", "yourdfpy", "xacro"]))
+    "mcap-ros2-support", "yourdfpy", "xacro", "zstandard"]))
 EOF
     echo "$want" > "$stamp"
     echo "setup_venv: installed into $venv in $(( $(date +%s) - start )) s" >&2

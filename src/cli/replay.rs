@@ -12,5 +12,9 @@ pub fn replay(args: &ModelArgs, opts: &ReplayOptions) -> Result<()> {
         // The reports before the fault are written; the bag itself is bad.
         return Err(anyhow!("{e}"));
     }
+    if let Some(e) = &summary.no_input {
+        // Nothing of the input was checked: not a success, whatever the reason.
+        return Err(anyhow!("{e}"));
+    }
     Ok(())
 }

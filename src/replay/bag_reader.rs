@@ -10,7 +10,10 @@
 //!   only with bytes actually read, so a corrupt length cannot allocate more than that.
 //! - sqlite3 rows come from a reader thread that owns the connection, over a channel bounded both
 //!   in messages ([`SQLITE_QUEUE`]) and in bytes ([`SQLITE_QUEUE_BYTES`]).
+//! - Compressed bags (`compression_mode` `message` or `file`, zstd; a bare `.zstd` file) are
+//!   decompressed as [`super::bag_compression`] describes, within the same bounds.
 
+use super::bag_compression::{compression_from_metadata, decompress_message, message_context, Compression, MessageContext, Scratch, MAX_FILE_BYTES};
 use mcap::read::ChannelAccumulator;
 use mcap::records::{op, Record};
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -58,8 +61,8 @@ pub enum BagError {
     /// The file cannot be read.
     #[error("cannot read bag {0}: {1}")]
     Io(PathBuf, std::io::Error),
-    /// Not a directory with metadata.yaml, an .mcap or a .db3 file.
-    #[error("{0}: unknown storage format (expected a rosbag2 directory with metadata.yaml, an .mcap file or a .db3 file)")]
+    /// Not a directory with metadata.yaml, an .mcap or a .db3 file (or one compressed as .zstd).
+    #[error("{0}: unknown storage format (expected a rosbag2 directory with metadata.yaml, an .mcap file or a .db3 file, or such a file compressed as .zstd)")]
     UnknownFormat(PathBuf),
     /// metadata.yaml is malformed or names a storage this reader does not know.
     #[error("{0}/metadata.yaml: {1}")]
@@ -84,6 +87,28 @@ pub enum BagError {
         /// What SQLite said.
         message: String,
     },
+    /// A compressed file or message payload that cannot be decompressed within the bounds.
+    #[error("{0}: {1}")]
+    Decompress(PathBuf, String),
+}
+
+impl BagError {
+    /// The same error naming `shown` (the `.zstd` file) instead of its decompressed copy.
+    fn shown_as(self, shown: &Path) -> Self {
+        match self {
+            BagError::Io(_, e) => BagError::Io(shown.to_owned(), e),
+            BagError::Mcap { after, message, .. } => BagError::Mcap { path: shown.to_owned(), after, message },
+            BagError::Sqlite { after, message, .. } => BagError::Sqlite { path: shown.to_owned(), after, message },
+            other => other,
+        }
+    }
+}
+
+/// A storage file: where it is read, and how errors name it (they differ for a decompressed copy).
+#[derive(Clone, Debug)]
+struct BagFile {
+    read: PathBuf,
+    shown: PathBuf,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,12 +124,20 @@ enum Storage {
 /// good messages before it), and `None` from then on.
 pub struct BagReader {
     storage: Storage,
-    files: Vec<PathBuf>,
+    compression: Compression,
+    files: Vec<BagFile>,
     next_file: usize,
     current: Option<Source>,
+    /// Messages of the current file yielded so far.
+    read_in_file: usize,
+    /// Message compression's zstd context, made at the first message.
+    message_context: Option<MessageContext>,
     topics: Vec<(String, String)>,
+    encodings: Vec<(String, String)>,
     topics_fault: Option<BagError>,
     done: bool,
+    /// The decompressed copies of a file-compressed bag (dropped last: after the sources).
+    _scratch: Option<Scratch>,
 }
 
 enum Source {
@@ -127,12 +160,20 @@ impl BagReader {
     pub fn topics_fault(&self) -> Option<&BagError> {
         self.topics_fault.as_ref()
     }
+
+    /// Topics and their message encodings as declared (MCAP: each channel's `message_encoding`;
+    /// sqlite3: the `topics` table's `serialization_format`), one pair per distinct encoding of a
+    /// topic. ROS 2 records `cdr`; an MCAP file converted from ROS 1 says `ros1`.
+    pub fn encodings(&self) -> &[(String, String)] {
+        &self.encodings
+    }
 }
 
 impl std::fmt::Debug for BagReader {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("BagReader")
             .field("storage", &self.storage)
+            .field("compression", &self.compression)
             .field("files", &self.files)
             .field("topics", &self.topics)
             .field("topics_fault", &self.topics_fault)
@@ -154,15 +195,16 @@ impl Iterator for BagReader {
                     return None;
                 };
                 self.next_file += 1;
+                self.read_in_file = 0;
                 let source = match self.storage {
-                    Storage::Mcap => McapStream::open(file).map(|s| Source::Mcap(Box::new(s))),
-                    Storage::Sqlite => SqliteStream::start(file).map(Source::Sqlite),
+                    Storage::Mcap => McapStream::open(&file.read).map(|s| Source::Mcap(Box::new(s))),
+                    Storage::Sqlite => SqliteStream::start(&file.read).map(Source::Sqlite),
                 };
                 match source {
                     Ok(s) => self.current = Some(s),
                     Err(e) => {
                         self.done = true;
-                        return Some(Err(e));
+                        return Some(Err(e.shown_as(&file.shown)));
                     }
                 }
             }
@@ -171,9 +213,26 @@ impl Iterator for BagReader {
                 Some(Source::Sqlite(s)) => s.next(),
                 None => None,
             };
+            let shown = || self.files.get(self.next_file.saturating_sub(1)).map(|f| f.shown.clone()).unwrap_or_default();
+            let item = match item {
+                Some(Ok(m)) if self.compression == Compression::Message => {
+                    Some(match message_context_of(&mut self.message_context).and_then(|c| decompress_message(&m.data, MAX_RECORD_BYTES, c)) {
+                        Ok(data) => Ok(BagMessage { data, ..m }),
+                        Err(e) => Err(BagError::Decompress(
+                            shown(),
+                            format!("message {} of the file (at {} ns on {}) {e} (compression_mode message, zstd)", self.read_in_file + 1, m.log_time, m.topic),
+                        )),
+                    })
+                }
+                other => other,
+            };
             match item {
-                Some(Ok(m)) => return Some(Ok(m)),
+                Some(Ok(m)) => {
+                    self.read_in_file += 1;
+                    return Some(Ok(m));
+                }
                 Some(Err(e)) => {
+                    let e = e.shown_as(&shown());
                     self.done = true;
                     self.current = None;
                     return Some(Err(e));
@@ -186,9 +245,17 @@ impl Iterator for BagReader {
 
 impl std::iter::FusedIterator for BagReader {}
 
-/// Opens a bag: checks the files, reads the topics, reads no messages (iterate for those).
+fn message_context_of(slot: &mut Option<MessageContext>) -> Result<&mut MessageContext, String> {
+    match slot {
+        Some(c) => Ok(c),
+        None => Ok(slot.insert(message_context()?)),
+    }
+}
+
+/// Opens a bag: checks the files, reads the topics, reads no messages (iterate for those). A
+/// file-compressed bag is decompressed here, every file, into the temporary folder.
 pub fn open_bag(path: &Path) -> Result<BagReader, BagError> {
-    let (storage, files) = if path.is_dir() {
+    let (storage, compression, files) = if path.is_dir() {
         let meta_path = path.join("metadata.yaml");
         if !meta_path.exists() {
             return Err(BagError::UnknownFormat(path.to_owned()));
@@ -216,42 +283,90 @@ pub fn open_bag(path: &Path) -> Result<BagReader, BagError> {
             "sqlite3" => Storage::Sqlite,
             other => return Err(BagError::Metadata(path.to_owned(), format!("unknown storage_identifier '{other}' (expected mcap or sqlite3)"))),
         };
-        (storage, files)
+        let compression = compression_from_metadata(info).map_err(|e| BagError::Metadata(path.to_owned(), e))?;
+        (storage, compression, files)
     } else {
-        match path.extension().and_then(|e| e.to_str()) {
-            Some("mcap") => (Storage::Mcap, vec![path.to_owned()]),
-            Some("db3") => (Storage::Sqlite, vec![path.to_owned()]),
+        let (inner, compression) = match path.extension().and_then(|e| e.to_str()) {
+            Some("zstd") => (path.file_stem().map(Path::new).and_then(|s| s.extension()).and_then(|e| e.to_str()), Compression::File),
+            e => (e, Compression::None),
+        };
+        match inner {
+            Some("mcap") => (Storage::Mcap, compression, vec![path.to_owned()]),
+            Some("db3") => (Storage::Sqlite, compression, vec![path.to_owned()]),
             _ if !path.exists() => return Err(BagError::Io(path.to_owned(), std::io::Error::from(std::io::ErrorKind::NotFound))),
             _ => return Err(BagError::UnknownFormat(path.to_owned())),
         }
     };
+    // File compression: rosbag2 names each file `<file>.zstd`; such a name is decompressed even
+    // when metadata.yaml does not say so (a file compressed by hand).
+    let mut scratch = None;
+    let files = files
+        .into_iter()
+        .map(|f| {
+            if compression != Compression::File && f.extension().is_none_or(|e| e != "zstd") {
+                return Ok(BagFile { read: f.clone(), shown: f });
+            }
+            if !f.exists() {
+                return Err(BagError::Io(f, std::io::Error::from(std::io::ErrorKind::NotFound)));
+            }
+            let s = match &mut scratch {
+                Some(s) => s,
+                None => {
+                    let tmp = std::env::temp_dir();
+                    let s = Scratch::create(&tmp)
+                        .map_err(|e| BagError::Decompress(f.clone(), format!("cannot make a folder in {} to decompress it into: {e}", tmp.display())))?;
+                    scratch.insert(s)
+                }
+            };
+            let read = s.decompress(&f, MAX_FILE_BYTES).map_err(|e| BagError::Decompress(f.clone(), e))?;
+            Ok(BagFile { read, shown: PathBuf::from(format!("{} (decompressed)", f.display())) })
+        })
+        .collect::<Result<Vec<_>, BagError>>()?;
     let mut topics = Vec::new();
+    let mut encodings = Vec::new();
     let mut seen = HashSet::new();
     let mut topics_fault = None;
     for file in &files {
         let (declared, fault) = match storage {
-            Storage::Mcap => mcap_topics(file)?,
-            Storage::Sqlite => (sqlite_topics(file)?, None),
+            Storage::Mcap => mcap_topics(&file.read).map_err(|e| e.shown_as(&file.shown))?,
+            Storage::Sqlite => (sqlite_topics(&file.read).map_err(|e| e.shown_as(&file.shown))?, None),
         };
-        for t in declared {
+        for (topic, ty, encoding) in declared {
+            if !encodings.iter().any(|(t, e)| *t == topic && *e == encoding) {
+                encodings.push((topic.clone(), encoding));
+            }
+            let t = (topic, ty);
             if seen.insert(t.clone()) {
                 topics.push(t);
             }
         }
         if fault.is_some() {
             // The iterator stops at this fault too: the files after it are never read.
-            topics_fault = fault;
+            topics_fault = fault.map(|e| e.shown_as(&file.shown));
             break;
         }
     }
-    Ok(BagReader { storage, files, next_file: 0, current: None, topics, topics_fault, done: false })
+    Ok(BagReader {
+        storage,
+        compression,
+        files,
+        next_file: 0,
+        current: None,
+        read_in_file: 0,
+        message_context: None,
+        topics,
+        encodings,
+        topics_fault,
+        done: false,
+        _scratch: scratch,
+    })
 }
 
 // ---------------------------------------------------------------------------------------------
 // MCAP
 
-/// (topic, type) pairs.
-type Topics = Vec<(String, String)>;
+/// (topic, type, message encoding) triples.
+type Topics = Vec<(String, String, String)>;
 
 /// Why a pass over an MCAP file stopped early.
 enum Fault {
@@ -378,7 +493,7 @@ fn check_strings(opcode: u8, body: &[u8]) -> Result<(), Fault> {
 struct Declared {
     schemas: HashMap<u16, String>,
     channel_ids: HashSet<u16>,
-    channels: Vec<(String, u16)>,
+    channels: Vec<(String, u16, String)>,
 }
 
 impl Declared {
@@ -391,7 +506,7 @@ impl Declared {
             Record::Schema { header, .. } => {
                 let _ = self.schemas.entry(header.id).or_insert(header.name);
             }
-            Record::Channel(c) if self.channel_ids.insert(c.id) => self.channels.push((c.topic, c.schema_id)),
+            Record::Channel(c) if self.channel_ids.insert(c.id) => self.channels.push((c.topic, c.schema_id, c.message_encoding)),
             _ => {}
         }
         Ok(())
@@ -399,7 +514,7 @@ impl Declared {
 
     fn topics(self) -> Topics {
         let schemas = self.schemas;
-        self.channels.into_iter().map(|(topic, schema)| (topic, schemas.get(&schema).cloned().unwrap_or_default())).collect()
+        self.channels.into_iter().map(|(topic, schema, encoding)| (topic, schemas.get(&schema).cloned().unwrap_or_default(), encoding)).collect()
     }
 }
 
@@ -547,16 +662,16 @@ fn sqlite_open(path: &Path) -> Result<rusqlite::Connection, BagError> {
         .map_err(|e| BagError::Sqlite { path: path.to_owned(), after: 0, message: e.to_string() })
 }
 
-fn sqlite_topic_rows(db: &rusqlite::Connection) -> rusqlite::Result<Vec<(i64, String, String)>> {
-    let mut stmt = db.prepare("SELECT id, name, type FROM topics ORDER BY id")?;
-    let rows = stmt.query_map([], |r| Ok((r.get::<_, i64>(0)?, r.get::<_, String>(1)?, r.get::<_, String>(2)?)))?;
+fn sqlite_topic_rows(db: &rusqlite::Connection) -> rusqlite::Result<Vec<(i64, String, String, String)>> {
+    let mut stmt = db.prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id")?;
+    let rows = stmt.query_map([], |r| Ok((r.get::<_, i64>(0)?, r.get::<_, String>(1)?, r.get::<_, String>(2)?, r.get::<_, String>(3)?)))?;
     rows.collect()
 }
 
 fn sqlite_topics(path: &Path) -> Result<Topics, BagError> {
     let db = sqlite_open(path)?;
     let rows = sqlite_topic_rows(&db).map_err(|e| BagError::Sqlite { path: path.to_owned(), after: 0, message: e.to_string() })?;
-    Ok(rows.into_iter().map(|(_, name, ty)| (name, ty)).collect())
+    Ok(rows.into_iter().map(|(_, name, ty, encoding)| (name, ty, encoding)).collect())
 }
 
 /// What the sqlite3 reader thread sends.
@@ -673,7 +788,8 @@ impl Drop for SqliteStream {
 
 /// The reader thread: every row in timestamp order. Ok(false) when the iterator went away.
 fn send_rows(db: &rusqlite::Connection, tx: &SyncSender<Row>, flow: &Flow) -> Result<bool, String> {
-    let topics: HashMap<i64, (String, String)> = sqlite_topic_rows(db).map_err(|e| e.to_string())?.into_iter().map(|(id, name, ty)| (id, (name, ty))).collect();
+    let topics: HashMap<i64, (String, String)> =
+        sqlite_topic_rows(db).map_err(|e| e.to_string())?.into_iter().map(|(id, name, ty, _)| (id, (name, ty))).collect();
     let mut stmt = db.prepare("SELECT topic_id, timestamp, length(data), data FROM messages ORDER BY timestamp, id").map_err(|e| e.to_string())?;
     let mut rows = stmt.query([]).map_err(|e| e.to_string())?;
     while let Some(row) = rows.next().map_err(|e| e.to_string())? {
@@ -1023,6 +1139,125 @@ mod tests {
         std::fs::write(&bad, b"this is not a database, it only has the name of one").unwrap();
         let e = open_bag(&bad).unwrap_err().to_string();
         assert!(e.contains("bad.db3"), "{e}");
+    }
+
+    /// An MCAP file with the messages of `bytes`, each payload passed through `payload`.
+    fn remap_mcap(bytes: &[u8], payload: impl Fn(&[u8]) -> Vec<u8>) -> Vec<u8> {
+        let mut buf = Cursor::new(Vec::new());
+        {
+            let mut w = mcap::WriteOptions::new().compression(Some(mcap::Compression::Zstd)).create(&mut buf).unwrap();
+            for m in mcap::MessageStream::new(bytes).unwrap() {
+                let m = m.unwrap();
+                w.write(&mcap::Message { data: std::borrow::Cow::Owned(payload(&m.data)), ..m }).unwrap();
+            }
+            let _ = w.finish().unwrap();
+        }
+        buf.into_inner()
+    }
+
+    fn compressed_metadata(dir: &Path, storage: &str, files: &[&str], mode: &str, format: &str) {
+        metadata(dir, storage, files);
+        let mut text = std::fs::read_to_string(dir.join("metadata.yaml")).unwrap();
+        text += &format!("  compression_format: {format}\n  compression_mode: {mode}\n");
+        std::fs::write(dir.join("metadata.yaml"), text).unwrap();
+    }
+
+    /// The scratch folders of this process in the temporary folder.
+    fn scratch_folders() -> usize {
+        let prefix = format!("thickness_collision_bag_{}_", std::process::id());
+        std::fs::read_dir(std::env::temp_dir()).unwrap().filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().starts_with(&prefix)).count()
+    }
+
+    #[test]
+    fn compressed_directories_read_like_plain_ones() {
+        let d = scratch("compressed");
+        let plain = write_mcap(mcap::WriteOptions::new(), 300);
+        let want = reference(&plain);
+        let zstd1 = |b: &[u8]| zstd::bulk::compress(b, 1).unwrap();
+
+        // Message mode, MCAP.
+        std::fs::write(d.join("bag_0.mcap"), remap_mcap(&plain, zstd1)).unwrap();
+        compressed_metadata(&d, "mcap", &["bag_0.mcap"], "MESSAGE", "zstd");
+        let (msgs, err) = all(open_bag(&d).unwrap());
+        assert!(err.is_none(), "{err:?}");
+        same(&msgs, &want);
+        // Without the metadata the payloads are what is stored: zstd frames.
+        let (raw, _) = all(open_bag(&d.join("bag_0.mcap")).unwrap());
+        assert!(raw.iter().all(|m| super::super::bag_compression::looks_like_zstd(&m.data)));
+
+        // A payload that declares 2^40 bytes: an error naming the file, the message and the size.
+        let mut lying = vec![0x28, 0xb5, 0x2f, 0xfd, 0xe0];
+        lying.extend_from_slice(&(1u64 << 40).to_le_bytes());
+        let n = std::cell::Cell::new(0);
+        std::fs::write(
+            d.join("bag_0.mcap"),
+            remap_mcap(&plain, |b| {
+                n.set(n.get() + 1);
+                if n.get() == 7 {
+                    lying.clone()
+                } else {
+                    zstd1(b)
+                }
+            }),
+        )
+        .unwrap();
+        let (msgs, err) = all(open_bag(&d).unwrap());
+        let err = err.expect("refused").to_string();
+        assert_eq!(msgs.len(), 6);
+        assert!(err.contains("bag_0.mcap: message 7 of the file") && err.contains("1099511627776 bytes") && err.contains("limit of 268435456"), "{err}");
+
+        // Message mode, sqlite3.
+        let rows: Vec<(i64, i64, Vec<u8>)> = (0..200).map(|k| (1 + (k % 2), k, payload(k as usize))).collect();
+        let packed: Vec<(i64, i64, Vec<u8>)> = rows.iter().map(|(t, k, p)| (*t, *k, zstd1(p))).collect();
+        write_db3(&d.join("bag_0.db3"), &packed);
+        compressed_metadata(&d, "sqlite3", &["bag_0.db3"], "message", "zstd");
+        let (msgs, err) = all(open_bag(&d).unwrap());
+        assert!(err.is_none(), "{err:?}");
+        assert_eq!(msgs.iter().map(|m| m.data.clone()).collect::<Vec<_>>(), rows.iter().map(|r| r.2.clone()).collect::<Vec<_>>());
+        let r = open_bag(&d).unwrap();
+        assert_eq!(r.encodings(), [("/joint_states".to_owned(), "cdr".to_owned()), ("/tf".to_owned(), "cdr".to_owned())]);
+
+        // File mode: two files, each compressed whole; a scratch folder while open, none after.
+        let second = write_mcap(mcap::WriteOptions::new().compression(Some(mcap::Compression::Lz4)), 50);
+        std::fs::write(d.join("bag_0.mcap.zstd"), zstd1(&plain)).unwrap();
+        std::fs::write(d.join("bag_1.mcap.zstd"), zstd1(&second)).unwrap();
+        compressed_metadata(&d, "mcap", &["bag_0.mcap.zstd", "bag_1.mcap.zstd"], "FILE", "zstd");
+        let r = open_bag(&d).unwrap();
+        assert_eq!(scratch_folders(), 1);
+        let (msgs, err) = all(r);
+        assert!(err.is_none(), "{err:?}");
+        let mut both = want.clone();
+        both.extend(reference(&second));
+        same(&msgs, &both);
+        assert_eq!(scratch_folders(), 0, "removed with the reader");
+        // A corrupt file inside: named as the compressed file, decompressed.
+        let mut cut = plain.clone();
+        cut.truncate(plain.len() * 6 / 10);
+        std::fs::write(d.join("bag_1.mcap.zstd"), zstd1(&cut)).unwrap();
+        let (_, err) = all(open_bag(&d).unwrap());
+        let err = err.expect("truncated").to_string();
+        assert!(err.contains("bag_1.mcap.zstd (decompressed): corrupt or truncated MCAP"), "{err}");
+        // Not zstd at all: refused at open, nothing left behind.
+        std::fs::write(d.join("bag_1.mcap.zstd"), &second).unwrap();
+        let err = open_bag(&d).unwrap_err().to_string();
+        assert!(err.contains("bag_1.mcap.zstd: is not a zstd file"), "{err}");
+        assert_eq!(scratch_folders(), 0, "removed on error");
+        // Missing.
+        compressed_metadata(&d, "mcap", &["bag_0.mcap.zstd", "gone.mcap.zstd"], "FILE", "zstd");
+        assert!(open_bag(&d).unwrap_err().to_string().contains("gone.mcap.zstd"));
+        // A bare .zstd file, and one whose inner name is not a storage.
+        let (msgs, err) = all(open_bag(&d.join("bag_0.mcap.zstd")).unwrap());
+        assert!(err.is_none());
+        same(&msgs, &want);
+        std::fs::write(d.join("notes.txt.zstd"), zstd1(b"x")).unwrap();
+        assert!(open_bag(&d.join("notes.txt.zstd")).unwrap_err().to_string().contains("unknown storage format"));
+
+        // Unknown formats and modes: refused at open, naming metadata.yaml and the value.
+        for (mode, format, says) in [("MESSAGE", "lz4", "compression_format 'lz4'"), ("CHUNK", "zstd", "compression_mode 'CHUNK'")] {
+            compressed_metadata(&d, "mcap", &["bag_0.mcap"], mode, format);
+            let err = open_bag(&d).unwrap_err().to_string();
+            assert!(err.contains("metadata.yaml") && err.contains(says), "{err}");
+        }
     }
 
     /// A reader can move to another thread.

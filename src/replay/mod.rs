@@ -2,6 +2,7 @@
 //! joint states (or `/tf`) in, one collision report per state out, as JSON lines, as a new rosbag2
 //! bag with the `collisions` topic, markers and the robot for viewers, and/or as a timeline SVG.
 
+mod bag_compression;
 mod bag_output;
 mod bag_reader;
 mod bag_writer;
@@ -11,7 +12,8 @@ mod replay_run;
 mod timeline;
 mod timeline_svg;
 
-pub use self::bag_reader::{open_bag, BagError, BagMessage, BagReader};
+pub use self::bag_compression::MAX_FILE_BYTES;
+pub use self::bag_reader::{open_bag, BagError, BagMessage, BagReader, MAX_RECORD_BYTES};
 pub use self::bag_writer::{BagWriter, TopicId};
 pub use self::cdr::{decode_cdr, encode_cdr_le, CdrError};
 pub use self::replay_run::{replay, ReplayOptions, ReplaySummary};

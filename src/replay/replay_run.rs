@@ -3,6 +3,7 @@
 //! rosbag2 bag (the report, its markers and the robot's poses) and/or a bar of the timeline. The
 //! bag is streamed: memory is bounded by the model, not the recording.
 
+use super::bag_compression::looks_like_zstd;
 use super::bag_output::{OutputBag, DESCRIPTION_TOPIC};
 use super::bag_reader::{open_bag, BagMessage};
 use super::cdr::decode_cdr;
@@ -67,6 +68,10 @@ pub struct ReplaySummary {
     pub seconds: f64,
     /// The fault that ended the bag early, if any (reports before it are kept).
     pub bag_error: Option<String>,
+    /// Why no message of the input topic was decoded, when none was: the topic has no messages,
+    /// none in the `--start`/`--end` window, or none decodes. The CLI exits 2 on it. Messages
+    /// that decode and are then refused by the pipeline (fail closed) do not set it.
+    pub no_input: Option<String>,
 }
 
 impl std::fmt::Display for ReplaySummary {
@@ -163,6 +168,10 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
             if pose_source == PoseSource::Tf { "tf" } else { "joint_states" }
         );
     }
+    // Every message would be undecodable: say why once, up front.
+    if let Some((_, encoding)) = bag.encodings().iter().find(|(t, e)| *t == topic && e != "cdr") {
+        bail!("topic {topic} in bag {} has message encoding '{encoding}'; replay decodes cdr (ROS 2's serialization) only", opts.bag.display());
+    }
     // Both doors start with the robot the parameters name; a description in the bag replaces it
     // at its log time, as it would replace it in the running node.
     let mut pipeline = if bag.topics().iter().any(|(t, _)| t == DESCRIPTION_TOPIC) {
@@ -208,6 +217,7 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
     let mut warnings = FirstWarnings::default();
     let mut t0 = None;
     let mut read = 0u64;
+    let mut input = InputCount::default();
     for item in bag {
         let m = match item {
             Ok(m) => m,
@@ -224,6 +234,7 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
         }
         let t0 = *t0.get_or_insert(m.log_time);
         let seconds = (m.log_time - t0) as f64 * 1e-9;
+        *input.per_topic.entry(m.topic.clone()).or_default() += 1;
         if let Some(b) = out.bag.as_mut() {
             b.input(&pipeline, &m)?;
         }
@@ -240,17 +251,28 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
                 None => continue,
             }
         } else if m.topic != topic || !in_window {
+            if m.topic == topic {
+                input.span = Some(input.span.map_or((seconds, seconds), |(a, b)| (a.min(seconds), b.max(seconds))));
+            }
             continue;
         } else {
-            match pose_source {
-                PoseSource::JointStates => match decode::<JointState>(&mut pipeline, &m, &mut warnings) {
-                    Some(msg) => pipeline.joint_state(&msg).map(Some),
-                    None => continue,
-                },
-                PoseSource::Tf => match decode::<TfMessage>(&mut pipeline, &m, &mut warnings) {
-                    Some(msg) => pipeline.tf(&msg).map(Some),
-                    None => continue,
-                },
+            input.in_window += 1;
+            let decoded = match pose_source {
+                PoseSource::JointStates => decode::<JointState>(&mut pipeline, &m, &mut warnings).map(|msg| pipeline.joint_state(&msg).map(Some)),
+                PoseSource::Tf => decode::<TfMessage>(&mut pipeline, &m, &mut warnings).map(|msg| pipeline.tf(&msg).map(Some)),
+            };
+            match decoded {
+                Some(state) => {
+                    input.decoded += 1;
+                    state
+                }
+                None => {
+                    input.zstd_frames += u64::from(looks_like_zstd(&m.data));
+                    if input.first_error.is_none() {
+                        input.first_error = Some(decode_error(pose_source, &m.data));
+                    }
+                    continue;
+                }
             }
         };
         for w in pipeline.take_warnings() {
@@ -293,7 +315,81 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
     }
     summary.seconds = started.elapsed().as_secs_f64();
     summary.skipped = pipeline.skipped().clone();
+    if summary.bag_error.is_none() {
+        summary.no_input = input.refusal(&topic, expected, &opts.bag, opts.start, opts.end);
+    }
     Ok(summary)
+}
+
+/// What the input topic gave, for the refusal of a replay that decoded none of it.
+#[derive(Default)]
+struct InputCount {
+    /// Messages read, per topic.
+    per_topic: BTreeMap<String, u64>,
+    /// Messages of the input topic in the `--start`/`--end` window.
+    in_window: u64,
+    /// Of those, decoded.
+    decoded: u64,
+    /// Of the undecodable ones, payloads that start like a zstd frame.
+    zstd_frames: u64,
+    first_error: Option<String>,
+    /// First and last time (s after the bag's first message) of the input topic's messages
+    /// outside the window.
+    span: Option<(f64, f64)>,
+}
+
+impl InputCount {
+    fn refusal(&self, topic: &str, expected: &str, bag: &Path, start: Option<f64>, end: Option<f64>) -> Option<String> {
+        let on_topic = self.per_topic.get(topic).copied().unwrap_or(0);
+        if self.decoded > 0 {
+            return None;
+        }
+        if on_topic == 0 {
+            let have: Vec<String> = self.per_topic.iter().map(|(t, n)| format!("{t} ({n})")).collect();
+            let have = if have.is_empty() { "no messages at all".to_owned() } else { format!("messages on {}", have.join(", ")) };
+            return Some(format!("bag {} has no messages on topic {topic}, so no state to check (it has {have})", bag.display()));
+        }
+        // "none of the 1 messages decodes" reads badly; one message gets its own wording.
+        let subject = |n: u64| if n == 1 { "the one message".to_owned() } else { format!("none of the {n} messages") };
+        let verb = |n: u64, one: &'static str, many: &'static str| if n == 1 { one } else { many };
+        if self.in_window == 0 {
+            let (a, b) = self.span.unwrap_or_default();
+            let flag = |f: &str, v: Option<f64>| v.map_or(String::new(), |v| format!(" {f} {v}"));
+            return Some(format!(
+                "{} on {topic} in bag {} {}{}{} (logged {a:.3} to {b:.3} s after the bag's first message)",
+                subject(on_topic),
+                bag.display(),
+                verb(on_topic, "is not inside", "is inside"),
+                flag("--start", start),
+                flag("--end", end)
+            ));
+        }
+        let hint = if self.zstd_frames == self.in_window {
+            verb(
+                self.in_window,
+                "; it is a zstd frame: a message-compressed bag read without its metadata.yaml (replay the bag's directory)",
+                "; they are zstd frames: a message-compressed bag read without its metadata.yaml (replay the bag's directory)",
+            )
+        } else {
+            ""
+        };
+        Some(format!(
+            "{} on {topic} in bag {} {} as CDR {expected} (the first error: {}){hint}",
+            subject(self.in_window),
+            bag.display(),
+            verb(self.in_window, "does not decode", "decodes"),
+            self.first_error.as_deref().unwrap_or("?")
+        ))
+    }
+}
+
+/// The decoder's complaint about a payload, for the refusal.
+fn decode_error(pose_source: PoseSource, data: &[u8]) -> String {
+    let e = match pose_source {
+        PoseSource::JointStates => decode_cdr::<JointState>(data).err(),
+        PoseSource::Tf => decode_cdr::<TfMessage>(data).err(),
+    };
+    e.map_or_else(|| "?".to_owned(), |e| e.to_string())
 }
 
 /// Decodes a message, or counts it as undecodable.
