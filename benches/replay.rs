@@ -11,7 +11,7 @@ use oorandom::Rand64;
 use std::time::Instant;
 use thickness_collision::checker::Checker;
 use thickness_collision::model::Params;
-use thickness_collision::replay::{replay, ReplayOptions};
+use thickness_collision::replay::{replay, Quiet, ReplayOptions};
 
 const STATES: usize = 100_000;
 
@@ -50,7 +50,6 @@ fn main() {
             jsonl: jsonl.then(|| root.join("out.jsonl")),
             start: None,
             end: None,
-            progress: false,
             // States on their own, as the figures in docs/benchmarks.md were taken; motions are
             // measured in benches/motion.rs.
             motion: Some(false),
@@ -58,7 +57,7 @@ fn main() {
             no_markers: true,
         };
         let started = Instant::now();
-        let summary = replay(Params::default(), None, None, &opts).unwrap();
+        let summary = replay(Params::default(), None, None, &opts, &mut Quiet).unwrap();
         let secs = started.elapsed().as_secs_f64();
         assert_eq!(summary.states, STATES);
         println!("{label:<44} {secs:>10.3} {:>12.0} {:>12.2}", STATES as f64 / secs, secs / STATES as f64 * 1e6);

@@ -119,7 +119,7 @@ fn scenario(root: &Path, checker: &Checker, sweep: bool, rounds: usize) {
                 ..Default::default()
             };
             let (started, cpu0) = (Instant::now(), cpu_seconds());
-            let summary = replay(Params::default(), None, None, &opts).unwrap();
+            let summary = replay(Params::default(), None, None, &opts, &mut thickness_collision::replay::Quiet).unwrap();
             let secs = started.elapsed().as_secs_f64();
             cpu[c].push(cpu_seconds() - cpu0);
             assert_eq!(summary.states, STATES);

@@ -174,20 +174,8 @@ fn run(cli: Cli) -> Result<()> {
             } else {
                 None
             };
-            let opts = thickness_collision::replay::ReplayOptions {
-                bag,
-                topic,
-                pose_source,
-                frame_prefix,
-                out_dir,
-                jsonl,
-                start,
-                end,
-                progress: true,
-                motion,
-                plot,
-                no_markers,
-            };
+            let opts =
+                thickness_collision::replay::ReplayOptions { bag, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, motion, plot, no_markers };
             cli::replay::replay(&model, &opts)
         }
     }

@@ -5,12 +5,12 @@
 
 use super::bag_reader::BagMessage;
 use super::bag_writer::{BagWriter, TopicId};
+use super::output_error::OutputError;
 use crate::checker::Checker;
 use crate::markers::{cell_markers, contact_markers};
 use crate::model::PoseSource;
 use crate::msgs::{DurationMsg, MarkerArray, StringMsg, TfMessage, Time, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};
 use crate::pipeline::{link_transforms, CheckedState, Pipeline, RobotState};
-use anyhow::{anyhow, Context, Result};
 use std::path::Path;
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 use std::sync::Arc;
@@ -63,7 +63,7 @@ pub(super) struct OutputBag {
     /// on, malloc and free were a fifth of the loop's time (perf, docs/benchmarks.md).
     done: Receiver<Vec<Job>>,
     batch: Vec<Job>,
-    writer: Option<JoinHandle<Result<()>>>,
+    writer: Option<JoinHandle<Result<(), OutputError>>>,
     view: Option<ViewState>,
 }
 
@@ -114,7 +114,7 @@ impl OutputBag {
         world: &str,
         frame_prefix: &str,
         view: bool,
-    ) -> Result<OutputBag> {
+    ) -> Result<OutputBag, OutputError> {
         let mut bag = BagWriter::create(dir)?;
         let collisions = bag.add_topic("/collisions", COLLISION_REPORT_TYPE, false)?;
         let topics = if view {
@@ -140,12 +140,11 @@ impl OutputBag {
         let (done_tx, done) = sync_channel(QUEUE + 2);
         let writer =
             Writer { bag, world: world.to_owned(), frame_prefix: frame_prefix.to_owned(), collisions, topics, robot: None, poses: TfMessage::default() };
-        let handle =
-            std::thread::Builder::new().name("bag writer".into()).spawn(move || writer.run(queue, done_tx)).context("cannot start the bag writer thread")?;
+        let handle = std::thread::Builder::new().name("bag writer".into()).spawn(move || writer.run(queue, done_tx)).map_err(OutputError::Thread)?;
         Ok(OutputBag { jobs: Some(jobs), done, batch: Vec::with_capacity(BATCH), writer: Some(handle), view: state })
     }
 
-    fn send(&mut self, job: Job) -> Result<()> {
+    fn send(&mut self, job: Job) -> Result<(), OutputError> {
         self.batch.push(job);
         if self.batch.len() < BATCH {
             return Ok(());
@@ -153,7 +152,7 @@ impl OutputBag {
         self.flush()
     }
 
-    fn flush(&mut self) -> Result<()> {
+    fn flush(&mut self) -> Result<(), OutputError> {
         let next = match self.done.try_recv() {
             Ok(mut written) => {
                 written.clear();
@@ -170,14 +169,14 @@ impl OutputBag {
         match sent {
             Some(Ok(())) => Ok(()),
             // The writer stopped on an error: finishing tells which.
-            _ => Err(self.stop().err().unwrap_or_else(|| anyhow!("the bag writer stopped"))),
+            _ => Err(self.stop().err().unwrap_or(OutputError::Stopped)),
         }
     }
 
     /// Every input message before it is replayed: at the first, the cells (once, at the bag's
     /// start) and the robot's URDF when the bag has none of its own; the input's `/tf`,
     /// `/tf_static` and `/robot_description` are copied as they are.
-    pub(super) fn input(&mut self, pipeline: &Pipeline, m: &BagMessage) -> Result<()> {
+    pub(super) fn input(&mut self, pipeline: &Pipeline, m: &BagMessage) -> Result<(), OutputError> {
         let Some(view) = self.view.as_mut() else { return Ok(()) };
         let mut jobs = Vec::new();
         if !view.started {
@@ -186,7 +185,7 @@ impl OutputBag {
             let cells = cell_markers(pipeline.checker(), params.marker_max_cells.max(0) as usize, &params.world_frame, Time::from_nanos(m.log_time));
             jobs.push(Job::Cells(cells, m.log_time));
             if !view.copy_description {
-                let urdf = pipeline.robot_urdf().context("the robot's URDF for /robot_description in the output bag")?;
+                let urdf = pipeline.robot_urdf().map_err(OutputError::Description)?;
                 jobs.push(Job::Description(StringMsg { data: urdf }, m.log_time));
             }
         }
@@ -203,7 +202,7 @@ impl OutputBag {
     }
 
     /// A report, and (for joint states, with the view on) the joint positions it was checked at.
-    pub(super) fn report(&mut self, pipeline: &Pipeline, state: &RobotState, checked: CheckedState, log_time: i64) -> Result<()> {
+    pub(super) fn report(&mut self, pipeline: &Pipeline, state: &RobotState, checked: CheckedState, log_time: i64) -> Result<(), OutputError> {
         let mut joints = None;
         let mut robot = None;
         if let Some(view) = self.view.as_mut().filter(|v| !v.copy_tf) {
@@ -222,22 +221,22 @@ impl OutputBag {
     }
 
     /// Waits for the writer to write everything, finish the MCAP file and `metadata.yaml`.
-    pub(super) fn finish(mut self) -> Result<()> {
+    pub(super) fn finish(mut self) -> Result<(), OutputError> {
         self.flush()?;
         self.stop()
     }
 
-    fn stop(&mut self) -> Result<()> {
+    fn stop(&mut self) -> Result<(), OutputError> {
         drop(self.jobs.take());
         match self.writer.take() {
-            Some(h) => h.join().map_err(|_| anyhow!("the bag writer panicked"))?,
+            Some(h) => h.join().map_err(|_| OutputError::Panicked)?,
             None => Ok(()),
         }
     }
 }
 
 impl Writer {
-    fn run(mut self, queue: Receiver<Vec<Job>>, done: SyncSender<Vec<Job>>) -> Result<()> {
+    fn run(mut self, queue: Receiver<Vec<Job>>, done: SyncSender<Vec<Job>>) -> Result<(), OutputError> {
         for batch in queue {
             for job in &batch {
                 self.write(job)?;
@@ -249,7 +248,7 @@ impl Writer {
         Ok(())
     }
 
-    fn write(&mut self, job: &Job) -> Result<()> {
+    fn write(&mut self, job: &Job) -> Result<(), OutputError> {
         let topics = self.topics.as_ref();
         match (job, topics) {
             (Job::Report { checked, joints, log_time }, _) => {

@@ -2,8 +2,8 @@
 
 use super::cdr::encode_cdr_le_into;
 use super::cdr_writer::CdrWriter;
+use super::output_error::OutputError;
 use crate::msgs::full_definition;
-use anyhow::{Context, Result};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::BufWriter;
@@ -41,14 +41,14 @@ pub struct BagWriter {
 
 impl BagWriter {
     /// Creates `dir`, which must not exist yet (as `ros2 bag record -o` requires).
-    pub fn create(dir: &Path) -> Result<BagWriter> {
+    pub fn create(dir: &Path) -> Result<BagWriter, OutputError> {
         if dir.exists() {
-            anyhow::bail!("output bag {} already exists", dir.display());
+            return Err(OutputError::Exists(dir.to_owned()));
         }
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|source| OutputError::Create { path: dir.to_owned(), source })?;
         let name = dir.file_name().and_then(|n| n.to_str()).unwrap_or("collisions");
         let file_name = format!("{name}_0.mcap");
-        let file = std::fs::File::create(dir.join(&file_name)).with_context(|| format!("cannot create {}", dir.join(&file_name).display()))?;
+        let file = std::fs::File::create(dir.join(&file_name)).map_err(|source| OutputError::Create { path: dir.join(&file_name), source })?;
         // Uncompressed, as `ros2 bag record` writes MCAP by default; zstd cost ~15 % of a replay.
         let writer = mcap::WriteOptions::new().profile("ros2").library("thickness_collision").compression(None).create(BufWriter::new(file))?;
         Ok(BagWriter { dir: dir.to_owned(), file_name, writer, schemas: BTreeMap::new(), topics: Vec::new(), first: None, last: 0, buf: Vec::new() })
@@ -56,11 +56,11 @@ impl BagWriter {
 
     /// Adds a topic of a type this crate has the full definition of (`crate::msgs::full_definition`);
     /// `latched` records it as offered transient local.
-    pub fn add_topic(&mut self, topic: &str, type_name: &'static str, latched: bool) -> Result<TopicId> {
+    pub fn add_topic(&mut self, topic: &str, type_name: &'static str, latched: bool) -> Result<TopicId, OutputError> {
         let schema = match self.schemas.get(type_name) {
             Some(id) => *id,
             None => {
-                let definition = full_definition(type_name).with_context(|| format!("no message definition for {type_name}"))?;
+                let definition = full_definition(type_name).ok_or_else(|| OutputError::NoDefinition(type_name.to_owned()))?;
                 let id = self.writer.add_schema(type_name, "ros2msg", definition.as_bytes())?;
                 let _ = self.schemas.insert(type_name, id);
                 id
@@ -75,7 +75,7 @@ impl BagWriter {
     }
 
     /// Appends one message received at `log_time` (nanoseconds).
-    pub fn write<T: Serialize>(&mut self, topic: TopicId, msg: &T, log_time: i64) -> Result<()> {
+    pub fn write<T: Serialize>(&mut self, topic: TopicId, msg: &T, log_time: i64) -> Result<(), OutputError> {
         let mut buf = std::mem::take(&mut self.buf);
         encode_cdr_le_into(&mut buf, msg);
         let written = self.write_raw(topic, &buf, log_time);
@@ -85,7 +85,7 @@ impl BagWriter {
 
     /// Appends one message encoded by `encode` (a [`super::cdr_writer::CdrWriter`] method) into the
     /// writer's reused buffer.
-    pub(super) fn write_with(&mut self, topic: TopicId, encode: impl FnOnce(CdrWriter), log_time: i64) -> Result<()> {
+    pub(super) fn write_with(&mut self, topic: TopicId, encode: impl FnOnce(CdrWriter), log_time: i64) -> Result<(), OutputError> {
         let mut buf = std::mem::take(&mut self.buf);
         encode(CdrWriter::new(&mut buf));
         let written = self.write_raw(topic, &buf, log_time);
@@ -94,7 +94,7 @@ impl BagWriter {
     }
 
     /// Appends one message already in CDR (with its encapsulation header), as copied from a bag.
-    pub fn write_raw(&mut self, topic: TopicId, data: &[u8], log_time: i64) -> Result<()> {
+    pub fn write_raw(&mut self, topic: TopicId, data: &[u8], log_time: i64) -> Result<(), OutputError> {
         let entry = &mut self.topics[topic.0];
         // MCAP sequence numbers are 32 bits and may wrap; readers order by log time.
         let header =
@@ -107,7 +107,7 @@ impl BagWriter {
     }
 
     /// Finishes the MCAP file and writes `metadata.yaml`.
-    pub fn finish(mut self) -> Result<PathBuf> {
+    pub fn finish(mut self) -> Result<PathBuf, OutputError> {
         let _ = self.writer.finish()?;
         let start = self.first.unwrap_or(0);
         let duration = self.last - start;
@@ -125,7 +125,7 @@ impl BagWriter {
             "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  duration:\n    nanoseconds: {duration}\n  starting_time:\n    nanoseconds_since_epoch: {start}\n  message_count: {total}\n  topics_with_message_count:\n{topics}  compression_format: ''\n  compression_mode: ''\n  relative_file_paths:\n    - {file}\n  files:\n    - path: {file}\n      starting_time:\n        nanoseconds_since_epoch: {start}\n      duration:\n        nanoseconds: {duration}\n      message_count: {total}\n",
             file = self.file_name,
         );
-        std::fs::write(self.dir.join("metadata.yaml"), meta).with_context(|| format!("cannot write {}", self.dir.join("metadata.yaml").display()))?;
+        std::fs::write(self.dir.join("metadata.yaml"), meta).map_err(|source| OutputError::Write { path: self.dir.join("metadata.yaml"), source })?;
         Ok(self.dir)
     }
 }

@@ -5,16 +5,19 @@
 
 use super::bag_compression::looks_like_zstd;
 use super::bag_output::{OutputBag, DESCRIPTION_TOPIC};
-use super::bag_reader::{open_bag, BagMessage};
+use super::bag_reader::{open_bag, BagError, BagMessage, BagReader};
 use super::cdr::decode_cdr;
+use super::output_error::OutputError;
+use super::replay_observer::{FirstWarnings, ReplayObserver};
+use super::replay_summary::{InputCount, ReplaySummary};
 use super::timeline::Timeline;
 use super::timeline_svg::timeline_svg;
+use crate::checker::CheckerError;
 use crate::model::{Params, PoseSource};
 use crate::msgs::{JointState, StringMsg, TfMessage};
 use crate::pipeline::{CheckedState, Pipeline, RobotState, Skip, SkipCause};
-use anyhow::{bail, Context, Result};
-use std::collections::{BTreeMap, HashSet};
-use std::io::{IsTerminal, Write};
+use std::collections::HashSet;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -39,8 +42,6 @@ pub struct ReplayOptions {
     pub start: Option<f64>,
     /// Skip states after this many seconds after the bag's first message.
     pub end: Option<f64>,
-    /// Show a progress bar (only drawn on a terminal).
-    pub progress: bool,
     /// Check the motion between consecutive states, overriding the parameters' `check_motion`.
     pub motion: Option<bool>,
     /// Draw the collision timeline into this SVG file.
@@ -49,338 +50,332 @@ pub struct ReplayOptions {
     pub no_markers: bool,
 }
 
-/// What a replay did.
-#[derive(Clone, Debug, Default)]
-pub struct ReplaySummary {
-    /// States checked.
-    pub states: usize,
-    /// States in collision (or failed closed).
-    pub in_collision: usize,
-    /// Deepest contact: (state index from 1, link, object, depth).
-    pub deepest: Option<(usize, String, String, f64)>,
-    /// Messages skipped, by cause.
-    pub skipped: BTreeMap<SkipCause, u64>,
-    /// `robot_description` messages applied, and refused.
-    pub descriptions: (usize, usize),
-    /// `/robot_description_semantic` messages (SRDF) applied and refused.
-    pub semantics: (usize, usize),
-    /// Wall time of the replay loop (seconds), reading and writing included.
-    pub seconds: f64,
-    /// The fault that ended the bag early, if any (reports before it are kept).
-    pub bag_error: Option<String>,
-    /// Why no message of the input topic was decoded, when none was: the topic has no messages,
-    /// none in the `--start`/`--end` window, or none decodes. The CLI exits 2 on it. Messages
-    /// that decode and are then refused by the pipeline (fail closed) do not set it.
-    pub no_input: Option<String>,
+/// Where the checked states go.
+struct Outputs {
+    jsonl: Option<(std::io::BufWriter<std::fs::File>, PathBuf)>,
+    bag: Option<OutputBag>,
+    plot: Option<(Timeline, PathBuf)>,
 }
 
-impl std::fmt::Display for ReplaySummary {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        writeln!(f, "states: {}, in collision: {}", self.states, self.in_collision)?;
-        match &self.deepest {
-            Some((i, l, o, d)) => writeln!(f, "deepest contact: {l} x {o}, {d:.4} m (state {i})")?,
-            None => writeln!(f, "deepest contact: none")?,
+impl Outputs {
+    /// Every output asked for, created now, so a path that cannot be written fails before the
+    /// bag is read.
+    fn create(opts: &ReplayOptions, bag: &BagReader, pipeline: &Pipeline, pose_source: PoseSource) -> Result<Outputs, OutputError> {
+        let create = |p: &PathBuf| std::fs::File::create(p).map_err(|source| OutputError::Create { path: p.clone(), source });
+        let jsonl = match &opts.jsonl {
+            Some(p) => Some((std::io::BufWriter::new(create(p)?), p.clone())),
+            None => None,
+        };
+        let params = pipeline.params();
+        let bag = match &opts.out_dir {
+            Some(d) => Some(OutputBag::create(d, bag.topics(), pose_source, &params.world_frame, &params.frame_prefix, !opts.no_markers)?),
+            None => None,
+        };
+        let plot = match &opts.plot {
+            Some(p) => {
+                let _ = create(p)?;
+                Some((Timeline::default(), p.clone()))
+            }
+            None => None,
+        };
+        Ok(Outputs { jsonl, bag, plot })
+    }
+
+    fn write(&mut self, pipeline: &Pipeline, state: &RobotState, checked: CheckedState, log_time: i64, seconds: f64) -> Result<(), OutputError> {
+        if let Some((w, path)) = self.jsonl.as_mut() {
+            w.write_all(checked.json().as_bytes()).and_then(|()| w.write_all(b"\n")).map_err(|source| OutputError::Write { path: path.clone(), source })?;
         }
-        let per = if self.states > 0 { self.seconds / self.states as f64 * 1e6 } else { 0.0 };
-        writeln!(f, "time: {:.3} s, {per:.2} us per state ({:.0} states/s)", self.seconds, self.states as f64 / self.seconds.max(1e-12))?;
-        if self.descriptions != (0, 0) {
-            writeln!(f, "robot descriptions: {} applied, {} refused", self.descriptions.0, self.descriptions.1)?;
+        if let Some((timeline, _)) = self.plot.as_mut() {
+            // A motion in collision may have met something only between the two states: the
+            // state's own check tells which links collide at the state (plotted differently).
+            let own = timeline
+                .needs_state_check(&checked.report)
+                .then(|| pipeline.check(state).report.contacts.into_iter().map(|c| c.link_name).collect::<HashSet<_>>());
+            timeline.record(seconds, &checked.report, own.as_ref());
         }
-        if self.semantics != (0, 0) {
-            writeln!(f, "robot semantic descriptions (SRDF): {} applied, {} refused", self.semantics.0, self.semantics.1)?;
+        if let Some(b) = self.bag.as_mut() {
+            b.report(pipeline, state, checked, log_time)?;
         }
-        let total: u64 = self.skipped.values().sum();
-        write!(f, "skipped messages: {total}")?;
-        for (cause, n) in &self.skipped {
-            write!(f, "\n  {n} x {}", cause.key())?;
+        Ok(())
+    }
+
+    fn finish(&mut self, bag: &Path) -> Result<(), OutputError> {
+        if let Some((mut w, path)) = self.jsonl.take() {
+            w.flush().map_err(|source| OutputError::Write { path, source })?;
         }
-        if let Some(e) = &self.bag_error {
-            write!(f, "\nbag error: {e}")?;
+        if let Some(b) = self.bag.take() {
+            b.finish()?;
+        }
+        if let Some((timeline, path)) = &self.plot {
+            let svg = timeline_svg(timeline, &bag.display().to_string())?;
+            std::fs::write(path, svg).map_err(|source| OutputError::Write { path: path.clone(), source })?;
         }
         Ok(())
     }
 }
 
-/// Warns about the first message of each kind of trouble only: a bag of a million bad messages
-/// must not print a million lines (the summary counts them all).
-#[derive(Default)]
-struct FirstWarnings {
-    seen: HashSet<String>,
+/// Why a replay cannot start or finish. Reports written before the error are kept.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReplayError {
+    /// The bag cannot be opened.
+    #[error(transparent)]
+    Bag(#[from] BagError),
+    /// The robot or environment cannot be loaded.
+    #[error(transparent)]
+    Checker(#[from] CheckerError),
+    /// An output cannot be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// The input topic is not in the bag.
+    #[error("topic {topic} is not in bag {} (it has: {have})", bag.display())]
+    MissingTopic {
+        /// The topic.
+        topic: String,
+        /// The bag.
+        bag: PathBuf,
+        /// The bag's topics, listed.
+        have: String,
+    },
+    /// The input topic has another type than the pose source reads.
+    #[error("topic {topic} in bag {} has type {found}; pose_source {source_name} reads {expected}", bag.display())]
+    WrongType {
+        /// The topic.
+        topic: String,
+        /// The bag.
+        bag: PathBuf,
+        /// Its type.
+        found: String,
+        /// `joint_states` or `tf`.
+        source_name: &'static str,
+        /// The type that pose source reads.
+        expected: &'static str,
+    },
+    /// The input topic is not CDR: every message would be undecodable.
+    #[error("topic {topic} in bag {} has message encoding '{encoding}'; replay decodes cdr (ROS 2's serialization) only", bag.display())]
+    Encoding {
+        /// The topic.
+        topic: String,
+        /// The bag.
+        bag: PathBuf,
+        /// Its encoding.
+        encoding: String,
+    },
+    /// The parameters' SRDF fitted no robot of the replay.
+    #[error("robot_semantic_file {file} fits neither the bundled arm nor a {DESCRIPTION_TOPIC} of bag {} ({applied} applied, {refused} refused)", bag.display())]
+    SemanticUnused {
+        /// The SRDF file.
+        file: String,
+        /// The bag.
+        bag: PathBuf,
+        /// Descriptions applied.
+        applied: usize,
+        /// Descriptions refused.
+        refused: usize,
+    },
 }
 
-impl FirstWarnings {
-    fn warn(&mut self, kind: &str, message: impl FnOnce() -> String) {
-        if self.seen.insert(kind.to_owned()) {
-            eprintln!("thickness_collision: warning: {} (further ones are counted, not printed)", message());
+/// Replays a bag, telling `observer` what it does. Reports before a corrupt tail are kept; the
+/// fault is in the summary (`bag_error`), as is a topic of which nothing decoded (`no_input`).
+pub fn replay(
+    params: Params,
+    robot: Option<&Path>,
+    environment: Option<&Path>,
+    opts: &ReplayOptions,
+    observer: &mut dyn ReplayObserver,
+) -> Result<ReplaySummary, ReplayError> {
+    let (mut replayer, bag) = Replayer::open(params, robot, environment, opts, observer)?;
+    for item in bag {
+        match item {
+            Ok(m) => replayer.message(m)?,
+            Err(e) => {
+                replayer.summary.bag_error = Some(e.to_string());
+                break;
+            }
         }
+    }
+    replayer.finish()
+}
+
+/// One replay in progress: the pipeline, the outputs, and what was counted.
+struct Replayer<'a> {
+    opts: &'a ReplayOptions,
+    pipeline: Pipeline,
+    out: Outputs,
+    summary: ReplaySummary,
+    warnings: FirstWarnings<'a>,
+    input: InputCount,
+    topic: String,
+    expected: &'static str,
+    pose_source: PoseSource,
+    t0: Option<i64>,
+    read: u64,
+    started: Instant,
+}
+
+impl<'a> Replayer<'a> {
+    /// Opens the bag and checks its input topic, loads the robot, creates the outputs.
+    fn open(
+        mut params: Params,
+        robot: Option<&Path>,
+        environment: Option<&Path>,
+        opts: &'a ReplayOptions,
+        observer: &'a mut dyn ReplayObserver,
+    ) -> Result<(Replayer<'a>, BagReader), ReplayError> {
+        if let Some(p) = opts.pose_source {
+            params.pose_source = p;
+        }
+        if let Some(m) = opts.motion {
+            params.check_motion = m;
+        }
+        if let Some(p) = &opts.frame_prefix {
+            params.frame_prefix = p.clone();
+        }
+        let pose_source = params.pose_source;
+        let bag = open_bag(&opts.bag)?;
+        let topic = opts.topic.clone().unwrap_or_else(|| match pose_source {
+            PoseSource::JointStates => "/joint_states".into(),
+            PoseSource::Tf => "/tf".into(),
+        });
+        let expected = input_type(&bag, &topic, pose_source, &opts.bag)?;
+        // Both doors start with the robot the parameters name; a description in the bag replaces
+        // it at its log time, as it would replace it in the running node.
+        let pipeline = if bag.topics().iter().any(|(t, _)| t == DESCRIPTION_TOPIC) {
+            // An SRDF given for the recorded robot is checked against it when it comes.
+            Pipeline::new_expecting_description(params, robot, environment)?
+        } else {
+            Pipeline::new(params, robot, environment)?
+        };
+        let out = Outputs::create(opts, &bag, &pipeline, pose_source)?;
+        let replayer = Replayer {
+            opts,
+            pipeline,
+            out,
+            summary: ReplaySummary::default(),
+            warnings: FirstWarnings::new(observer),
+            input: InputCount::default(),
+            topic,
+            expected,
+            pose_source,
+            t0: None,
+            read: 0,
+            started: Instant::now(),
+        };
+        Ok((replayer, bag))
+    }
+
+    /// One bag message, in storage order.
+    fn message(&mut self, m: BagMessage) -> Result<(), ReplayError> {
+        self.read += 1;
+        if self.read % 1024 == 0 {
+            self.warnings.observer.progress(self.read);
+        }
+        let t0 = *self.t0.get_or_insert(m.log_time);
+        let seconds = (m.log_time - t0) as f64 * 1e-9;
+        *self.input.per_topic.entry(m.topic.clone()).or_default() += 1;
+        if let Some(b) = self.out.bag.as_mut() {
+            b.input(&self.pipeline, &m)?;
+        }
+        let Some(state) = self.state_of(&m, seconds) else { return Ok(()) };
+        for w in self.pipeline.take_warnings() {
+            self.warnings.observer.warning(&w);
+        }
+        match state {
+            Ok(Some(state)) => {
+                // One state per report, as the node gives when it keeps up.
+                let Some(checked) = self.pipeline.check_path(std::slice::from_ref(&state)) else { return Ok(()) };
+                self.summary.record(&checked);
+                self.out.write(&self.pipeline, &state, checked, m.log_time, seconds)?;
+            }
+            Ok(None) => {}
+            Err(Skip { cause, message }) => {
+                self.warnings.warn(cause.key(), || format!("message at log time {} ns skipped ({}): {message}", m.log_time, cause.key()))
+            }
+        }
+        Ok(())
+    }
+
+    /// What message `m` (at `seconds` into the bag) means for the pipeline: `None` when it is
+    /// not a state (applied, out of the window, another topic, undecodable), else the state or
+    /// why it is none.
+    fn state_of(&mut self, m: &BagMessage, seconds: f64) -> Option<Result<Option<RobotState>, Skip>> {
+        let (opts, pipeline, warnings) = (self.opts, &mut self.pipeline, &mut self.warnings);
+        if m.topic == DESCRIPTION_TOPIC {
+            apply_description(pipeline, m, &opts.bag, &mut self.summary, warnings);
+            return None;
+        }
+        if m.topic == SEMANTIC_TOPIC {
+            apply_semantic(pipeline, m, &opts.bag, &mut self.summary, warnings);
+            return None;
+        }
+        if self.pose_source == PoseSource::Tf && m.topic == "/tf_static" {
+            return decode::<TfMessage>(pipeline, m, warnings).map(|msg| pipeline.tf_static(&msg).map(|()| None));
+        }
+        if m.topic != self.topic {
+            return None;
+        }
+        let in_window = opts.start.is_none_or(|a| seconds >= a) && opts.end.is_none_or(|b| seconds <= b);
+        if !in_window {
+            self.input.span = Some(self.input.span.map_or((seconds, seconds), |(a, b)| (a.min(seconds), b.max(seconds))));
+            return None;
+        }
+        self.input.in_window += 1;
+        let decoded = match self.pose_source {
+            PoseSource::JointStates => decode::<JointState>(pipeline, m, warnings).map(|msg| pipeline.joint_state(&msg).map(Some)),
+            PoseSource::Tf => decode::<TfMessage>(pipeline, m, warnings).map(|msg| pipeline.tf(&msg).map(Some)),
+        };
+        if decoded.is_some() {
+            self.input.decoded += 1;
+        } else {
+            self.input.zstd_frames += u64::from(looks_like_zstd(&m.data));
+            if self.input.first_error.is_none() {
+                self.input.first_error = Some(decode_error(self.pose_source, &m.data));
+            }
+        }
+        decoded
+    }
+
+    /// Finishes the outputs and the summary.
+    fn finish(mut self) -> Result<ReplaySummary, ReplayError> {
+        self.warnings.observer.finished();
+        self.out.finish(&self.opts.bag)?;
+        if self.pipeline.semantic_deferred() {
+            return Err(ReplayError::SemanticUnused {
+                file: self.pipeline.params().robot_semantic_file.clone(),
+                bag: self.opts.bag.clone(),
+                applied: self.summary.descriptions.0,
+                refused: self.summary.descriptions.1,
+            });
+        }
+        self.summary.seconds = self.started.elapsed().as_secs_f64();
+        self.summary.skipped = self.pipeline.skipped().clone();
+        if self.summary.bag_error.is_none() {
+            self.summary.no_input = self.input.refusal(&self.topic, self.expected, &self.opts.bag, self.opts.start, self.opts.end);
+        }
+        Ok(self.summary)
     }
 }
 
-/// Where the checked states go.
-struct Outputs {
-    jsonl: Option<std::io::BufWriter<std::fs::File>>,
-    jsonl_path: Option<PathBuf>,
-    bag: Option<OutputBag>,
-    plot: Option<(Timeline, PathBuf)>,
-}
-
-/// Replays a bag. Reports before a corrupt tail are kept; the fault is in the summary and makes
-/// the result an error after the outputs are written.
-pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, opts: &ReplayOptions) -> Result<ReplaySummary> {
-    let mut params = params;
-    if let Some(p) = opts.pose_source {
-        params.pose_source = p;
-    }
-    if let Some(m) = opts.motion {
-        params.check_motion = m;
-    }
-    if let Some(p) = &opts.frame_prefix {
-        params.frame_prefix = p.clone();
-    }
-    let pose_source = params.pose_source;
-    for (flag, v) in [("--start", opts.start), ("--end", opts.end)] {
-        if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
-            bail!("{flag} {v}: must be a finite number of seconds >= 0 after the bag's first message");
-        }
-    }
-    if let (Some(a), Some(b)) = (opts.start, opts.end) {
-        if a > b {
-            bail!("--start {a} is after --end {b}: no message could be replayed");
-        }
-    }
-    let bag = open_bag(&opts.bag)?;
-    let topic = opts.topic.clone().unwrap_or_else(|| match pose_source {
-        PoseSource::JointStates => "/joint_states".into(),
-        PoseSource::Tf => "/tf".into(),
-    });
+/// The type `pose_source` reads on `topic`, after checking the bag has the topic with that type
+/// and in CDR.
+fn input_type(bag: &BagReader, topic: &str, pose_source: PoseSource, path: &Path) -> Result<&'static str, ReplayError> {
     if !bag.topics().iter().any(|(t, _)| *t == topic) {
         let have: Vec<&str> = bag.topics().iter().map(|(t, _)| t.as_str()).collect();
-        bail!("topic {topic} is not in bag {} (it has: {})", opts.bag.display(), crate::limits::name_list(&have));
+        return Err(ReplayError::MissingTopic { topic: topic.to_owned(), bag: path.to_owned(), have: crate::limits::name_list(&have) });
     }
     let expected = match pose_source {
         PoseSource::JointStates => "sensor_msgs/msg/JointState",
         PoseSource::Tf => "tf2_msgs/msg/TFMessage",
     };
     if let Some((_, ty)) = bag.topics().iter().find(|(t, ty)| *t == topic && !ty.is_empty() && ty != expected) {
-        bail!(
-            "topic {topic} in bag {} has type {ty}; pose_source {} reads {expected}",
-            opts.bag.display(),
-            if pose_source == PoseSource::Tf { "tf" } else { "joint_states" }
-        );
+        let source_name = if pose_source == PoseSource::Tf { "tf" } else { "joint_states" };
+        return Err(ReplayError::WrongType { topic: topic.to_owned(), bag: path.to_owned(), found: ty.clone(), source_name, expected });
     }
     // Every message would be undecodable: say why once, up front.
     if let Some((_, encoding)) = bag.encodings().iter().find(|(t, e)| *t == topic && e != "cdr") {
-        bail!("topic {topic} in bag {} has message encoding '{encoding}'; replay decodes cdr (ROS 2's serialization) only", opts.bag.display());
+        return Err(ReplayError::Encoding { topic: topic.to_owned(), bag: path.to_owned(), encoding: encoding.clone() });
     }
-    // Both doors start with the robot the parameters name; a description in the bag replaces it
-    // at its log time, as it would replace it in the running node.
-    let mut pipeline = if bag.topics().iter().any(|(t, _)| t == DESCRIPTION_TOPIC) {
-        // An SRDF given for the recorded robot is checked against it when it comes.
-        Pipeline::new_expecting_description(params, robot, environment)?
-    } else {
-        Pipeline::new(params, robot, environment)?
-    };
-
-    let mut out = Outputs {
-        jsonl: match &opts.jsonl {
-            Some(p) => Some(std::io::BufWriter::new(std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?)),
-            None => None,
-        },
-        jsonl_path: opts.jsonl.clone(),
-        bag: match &opts.out_dir {
-            Some(d) => {
-                Some(OutputBag::create(d, bag.topics(), pose_source, &pipeline.params().world_frame, &pipeline.params().frame_prefix, !opts.no_markers)?)
-            }
-            None => None,
-        },
-        plot: match &opts.plot {
-            // Created now, so a path that cannot be written fails before the bag is read.
-            Some(p) => {
-                let _ = std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?;
-                Some((Timeline::default(), p.clone()))
-            }
-            None => None,
-        },
-    };
-    let bar = if opts.progress && std::io::stderr().is_terminal() {
-        let b = indicatif::ProgressBar::new_spinner();
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} {pos} messages {per_sec}").unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
-        );
-        Some(b)
-    } else {
-        None
-    };
-
-    let started = Instant::now();
-    let mut summary = ReplaySummary::default();
-    let mut warnings = FirstWarnings::default();
-    let mut t0 = None;
-    let mut read = 0u64;
-    let mut input = InputCount::default();
-    for item in bag {
-        let m = match item {
-            Ok(m) => m,
-            Err(e) => {
-                summary.bag_error = Some(e.to_string());
-                break;
-            }
-        };
-        read += 1;
-        if let Some(b) = &bar {
-            if read % 1024 == 0 {
-                b.set_position(read);
-            }
-        }
-        let t0 = *t0.get_or_insert(m.log_time);
-        let seconds = (m.log_time - t0) as f64 * 1e-9;
-        *input.per_topic.entry(m.topic.clone()).or_default() += 1;
-        if let Some(b) = out.bag.as_mut() {
-            b.input(&pipeline, &m)?;
-        }
-        let in_window = opts.start.is_none_or(|a| seconds >= a) && opts.end.is_none_or(|b| seconds <= b);
-        let state = if m.topic == DESCRIPTION_TOPIC {
-            apply_description(&mut pipeline, &m, &opts.bag, &mut summary, &mut warnings);
-            continue;
-        } else if m.topic == SEMANTIC_TOPIC {
-            apply_semantic(&mut pipeline, &m, &opts.bag, &mut summary, &mut warnings);
-            continue;
-        } else if pose_source == PoseSource::Tf && m.topic == "/tf_static" {
-            match decode::<TfMessage>(&mut pipeline, &m, &mut warnings) {
-                Some(msg) => pipeline.tf_static(&msg).map(|()| None),
-                None => continue,
-            }
-        } else if m.topic != topic || !in_window {
-            if m.topic == topic {
-                input.span = Some(input.span.map_or((seconds, seconds), |(a, b)| (a.min(seconds), b.max(seconds))));
-            }
-            continue;
-        } else {
-            input.in_window += 1;
-            let decoded = match pose_source {
-                PoseSource::JointStates => decode::<JointState>(&mut pipeline, &m, &mut warnings).map(|msg| pipeline.joint_state(&msg).map(Some)),
-                PoseSource::Tf => decode::<TfMessage>(&mut pipeline, &m, &mut warnings).map(|msg| pipeline.tf(&msg).map(Some)),
-            };
-            match decoded {
-                Some(state) => {
-                    input.decoded += 1;
-                    state
-                }
-                None => {
-                    input.zstd_frames += u64::from(looks_like_zstd(&m.data));
-                    if input.first_error.is_none() {
-                        input.first_error = Some(decode_error(pose_source, &m.data));
-                    }
-                    continue;
-                }
-            }
-        };
-        for w in pipeline.take_warnings() {
-            eprintln!("thickness_collision: warning: {w}");
-        }
-        match state {
-            Ok(Some(state)) => {
-                // One state per report, as the node gives when it keeps up.
-                let Some(checked) = pipeline.check_path(std::slice::from_ref(&state)) else { continue };
-                record(&mut summary, &checked);
-                write_outputs(&mut out, &pipeline, &state, checked, m.log_time, seconds)?;
-            }
-            Ok(None) => {}
-            Err(Skip { cause, message }) => {
-                warnings.warn(cause.key(), || format!("message at log time {} ns skipped ({}): {message}", m.log_time, cause.key()))
-            }
-        }
-    }
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
-    if let (Some(mut w), Some(path)) = (out.jsonl, &opts.jsonl) {
-        w.flush().with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    if let Some(b) = out.bag {
-        b.finish()?;
-    }
-    if let Some((timeline, path)) = &out.plot {
-        let svg = timeline_svg(timeline, &opts.bag.display().to_string()).map_err(anyhow::Error::msg)?;
-        std::fs::write(path, svg).with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    if pipeline.semantic_deferred() {
-        bail!(
-            "robot_semantic_file {} fits neither the bundled arm nor a {DESCRIPTION_TOPIC} of bag {} ({} applied, {} refused)",
-            pipeline.params().robot_semantic_file,
-            opts.bag.display(),
-            summary.descriptions.0,
-            summary.descriptions.1
-        );
-    }
-    summary.seconds = started.elapsed().as_secs_f64();
-    summary.skipped = pipeline.skipped().clone();
-    if summary.bag_error.is_none() {
-        summary.no_input = input.refusal(&topic, expected, &opts.bag, opts.start, opts.end);
-    }
-    Ok(summary)
-}
-
-/// What the input topic gave, for the refusal of a replay that decoded none of it.
-#[derive(Default)]
-struct InputCount {
-    /// Messages read, per topic.
-    per_topic: BTreeMap<String, u64>,
-    /// Messages of the input topic in the `--start`/`--end` window.
-    in_window: u64,
-    /// Of those, decoded.
-    decoded: u64,
-    /// Of the undecodable ones, payloads that start like a zstd frame.
-    zstd_frames: u64,
-    first_error: Option<String>,
-    /// First and last time (s after the bag's first message) of the input topic's messages
-    /// outside the window.
-    span: Option<(f64, f64)>,
-}
-
-impl InputCount {
-    fn refusal(&self, topic: &str, expected: &str, bag: &Path, start: Option<f64>, end: Option<f64>) -> Option<String> {
-        let on_topic = self.per_topic.get(topic).copied().unwrap_or(0);
-        if self.decoded > 0 {
-            return None;
-        }
-        if on_topic == 0 {
-            let have: Vec<String> = self.per_topic.iter().map(|(t, n)| format!("{t} ({n})")).collect();
-            let have = if have.is_empty() { "no messages at all".to_owned() } else { format!("messages on {}", have.join(", ")) };
-            return Some(format!("bag {} has no messages on topic {topic}, so no state to check (it has {have})", bag.display()));
-        }
-        // "none of the 1 messages decodes" reads badly; one message gets its own wording.
-        let subject = |n: u64| if n == 1 { "the one message".to_owned() } else { format!("none of the {n} messages") };
-        let verb = |n: u64, one: &'static str, many: &'static str| if n == 1 { one } else { many };
-        if self.in_window == 0 {
-            let (a, b) = self.span.unwrap_or_default();
-            let flag = |f: &str, v: Option<f64>| v.map_or(String::new(), |v| format!(" {f} {v}"));
-            return Some(format!(
-                "{} on {topic} in bag {} {}{}{} (logged {a:.3} to {b:.3} s after the bag's first message)",
-                subject(on_topic),
-                bag.display(),
-                verb(on_topic, "is not inside", "is inside"),
-                flag("--start", start),
-                flag("--end", end)
-            ));
-        }
-        let hint = if self.zstd_frames == self.in_window {
-            verb(
-                self.in_window,
-                "; it is a zstd frame: a message-compressed bag read without its metadata.yaml (replay the bag's directory)",
-                "; they are zstd frames: a message-compressed bag read without its metadata.yaml (replay the bag's directory)",
-            )
-        } else {
-            ""
-        };
-        Some(format!(
-            "{} on {topic} in bag {} {} as CDR {expected} (the first error: {}){hint}",
-            subject(self.in_window),
-            bag.display(),
-            verb(self.in_window, "does not decode", "decodes"),
-            self.first_error.as_deref().unwrap_or("?")
-        ))
-    }
+    Ok(expected)
 }
 
 /// The decoder's complaint about a payload, for the refusal.
@@ -412,7 +407,7 @@ fn apply_description(pipeline: &mut Pipeline, m: &BagMessage, bag: &Path, summar
         Ok(()) => {
             summary.descriptions.0 += 1;
             let s = pipeline.checker().summary();
-            eprintln!("thickness_collision: robot from {source}: {} links, {} checked", s.robot_links, s.checked_links);
+            warnings.observer.note(&format!("robot from {source}: {} links, {} checked", s.robot_links, s.checked_links));
         }
         Err(e) => {
             summary.descriptions.1 += 1;
@@ -429,41 +424,11 @@ fn apply_semantic(pipeline: &mut Pipeline, m: &BagMessage, bag: &Path, summary: 
     match result {
         Ok(()) => {
             summary.semantics.0 += 1;
-            eprintln!("thickness_collision: {}", pipeline.checker().self_pairs().summary(pipeline.checker()));
+            warnings.observer.note(&pipeline.checker().self_pairs().summary(pipeline.checker()));
         }
         Err(e) => {
             summary.semantics.1 += 1;
             warnings.warn("semantic", || format!("{source} refused, keeping the current collision matrix: {e}"));
         }
     }
-}
-
-fn record(summary: &mut ReplaySummary, checked: &CheckedState) {
-    summary.states += 1;
-    if checked.report.in_collision {
-        summary.in_collision += 1;
-    }
-    for c in &checked.report.contacts {
-        if summary.deepest.as_ref().is_none_or(|d| c.depth > d.3) {
-            summary.deepest = Some((summary.states, c.link_name.clone(), c.object_name.clone(), c.depth));
-        }
-    }
-}
-
-fn write_outputs(out: &mut Outputs, pipeline: &Pipeline, state: &RobotState, checked: CheckedState, log_time: i64, seconds: f64) -> Result<()> {
-    if let (Some(w), Some(path)) = (out.jsonl.as_mut(), &out.jsonl_path) {
-        w.write_all(checked.json().as_bytes()).and_then(|()| w.write_all(b"\n")).with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    if let Some((timeline, _)) = out.plot.as_mut() {
-        // A motion in collision may have met something only between the two states: the state's
-        // own check tells which links collide at the state (plotted differently).
-        let own = timeline
-            .needs_state_check(&checked.report)
-            .then(|| pipeline.check(state).report.contacts.into_iter().map(|c| c.link_name).collect::<std::collections::HashSet<_>>());
-        timeline.record(seconds, &checked.report, own.as_ref());
-    }
-    if let Some(b) = out.bag.as_mut() {
-        b.report(pipeline, state, checked, log_time)?;
-    }
-    Ok(())
 }

@@ -29,14 +29,14 @@ struct DrawnBar {
 }
 
 /// The picture of `timeline` for the bag named `bag`.
-pub fn timeline_svg(timeline: &Timeline, bag: &str) -> Result<String, String> {
+pub fn timeline_svg(timeline: &Timeline, bag: &str) -> Result<String, super::output_error::OutputError> {
     let rows = timeline.rows.len().max(1) as u32;
     let height = HEADER + rows * ROW + FOOTER;
     let mut svg = String::new();
     let drawn = {
         let root = SVGBackend::with_string(&mut svg, (WIDTH, height)).into_drawing_area();
-        let drawn = draw(&root, timeline, bag).map_err(|e| format!("drawing the timeline failed: {e}"))?;
-        root.present().map_err(|e| format!("drawing the timeline failed: {e}"))?;
+        let drawn = draw(&root, timeline, bag).map_err(|e| super::output_error::OutputError::Timeline(e.to_string()))?;
+        root.present().map_err(|e| super::output_error::OutputError::Timeline(e.to_string()))?;
         drawn
     };
     Ok(with_titles(&svg, &drawn))
