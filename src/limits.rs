@@ -35,8 +35,9 @@ pub use crate::msgs::MAX_JOINT_STATE_ENTRIES;
 /// (`msgs::MAX_TRAJECTORY_ENTRIES`, refused while decoding; the same figures are checked again by
 /// `Pipeline::trajectory_job`, with one-line errors).
 pub use crate::msgs::MAX_TRAJECTORY_ENTRIES;
-/// Motion-check sub-intervals one `check_trajectory` request may spend in all.
-pub use crate::pipeline::MAX_TRAJECTORY_SUBINTERVALS;
+/// Motion-check sub-intervals one `check_trajectory` request may spend in all (about 100 s of a
+/// worker's time on the bundled workcell).
+pub const MAX_TRAJECTORY_SUBINTERVALS: u64 = 1 << 22;
 
 /// A file that cannot be read within the bounds.
 #[derive(Debug, thiserror::Error)]

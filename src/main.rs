@@ -162,7 +162,7 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Areas { mesh, thickness, side, scale, json } => cli::areas::areas(mesh, thickness, side, &scale, json),
         Command::Check { model, joints, states, json, motion, show_params } => {
-            cli::check::check(&model, joints.as_deref(), states.as_deref(), json, motion, show_params)
+            cli::check::check(&model, &cli::check::CheckRequest { joints: joints.as_deref(), states: states.as_deref(), json, motion, show_params })
         }
         #[cfg(feature = "ros")]
         Command::Run { model, ros_args } => cli::run::run(&model, &ros_args),

@@ -30,14 +30,7 @@ use std::sync::Arc;
 /// Points a trajectory may have (the decoder refuses longer sequences already).
 pub const MAX_TRAJECTORY_POINTS: usize = MAX_TRAJECTORY_ENTRIES;
 
-/// Sub-intervals the motion checks of one request may examine in all (`MotionReport::subintervals`
-/// summed over its segments); the segments after the budget is spent are not checked and the
-/// request fails closed. One sub-interval costs some 25 µs on the bundled workcell, so this bounds a
-/// request to about 100 s of the worker's time (plus one segment, itself bounded by
-/// `checker::MAX_SUBINTERVALS`, 2^20): without it 65,535 segments of 1,000 rad each, about 1 s
-/// apiece, would hold the worker for 18 hours. A planner's trajectory of 36,000 free segments in
-/// `tests/ros_trajectory.rs` spends some 250,000.
-pub const MAX_TRAJECTORY_SUBINTERVALS: u64 = 1 << 22;
+pub use crate::limits::MAX_TRAJECTORY_SUBINTERVALS;
 
 /// Names a trajectory may give (more than any robot has joints; the decoder refuses longer lists
 /// already).
@@ -99,52 +92,10 @@ fn resolve(pipeline: &Pipeline, trajectory: &JointTrajectory) -> Result<Plan, St
     if names.len() > MAX_TRAJECTORY_NAMES {
         return Err(format!("the trajectory names {} joints; at most {MAX_TRAJECTORY_NAMES} allowed", names.len()));
     }
-    // Joint index of every name; unknown and repeated names refused (all unknown ones quoted).
-    let mut index = Vec::with_capacity(names.len());
+    let index = joint_indices(robot, names)?;
     let mut seen = vec![false; robot.joints.len()];
-    let (mut unknown, mut unknown_count): (Vec<String>, usize) = (Vec::new(), 0);
-    for name in names {
-        match robot.joint(name) {
-            Some(j) if seen[j] => return Err(format!("joint_names gives joint '{name}' twice")),
-            Some(j) => {
-                seen[j] = true;
-                index.push(j);
-            }
-            // Quoted as the errors quote names; the error quotes a few and counts the rest.
-            None => {
-                unknown_count += 1;
-                if unknown.len() < MAX_NAMES_IN_ERROR {
-                    unknown.push(format!("'{name}'"));
-                }
-            }
-        }
-    }
-    if unknown_count > 0 {
-        let more = if unknown_count > unknown.len() { format!(" and {} more", unknown_count - unknown.len()) } else { String::new() };
-        let what = if unknown_count == 1 { "is not a joint" } else { "are not joints" };
-        return Err(format!("joint_names: {}{more} {what} of the robot model", unknown.join(", ")));
-    }
-    // Joints the trajectory leaves out: the current merged state, else the missing_joint rule.
-    let missing = pipeline.params().missing_joint;
-    let mut base = Vec::with_capacity(robot.joints.len());
-    for (ji, ((joint, current), named)) in robot.joints.iter().zip(pipeline.current_joints()).zip(&seen).enumerate() {
-        base.push(match current {
-            _ if *named => 0.0,
-            Some(v) => *v,
-            None if joint.is_actuated() && missing == MissingJoint::Reject => {
-                return Err(format!("joint '{}' is neither in joint_names nor in a joint state received so far (missing_joint: reject)", joint.name))
-            }
-            // Under `last` an unknown joint that moves a checked link leaves the robot's pose
-            // unknown: checking it at 0 could call a colliding trajectory free.
-            None if missing == MissingJoint::Last && pipeline.checker().moves_checked_link(ji) => {
-                return Err(format!(
-                    "joint '{}' is neither in joint_names nor in a joint state received so far (missing_joint: last takes it from the joint states)",
-                    joint.name
-                ))
-            }
-            None => 0.0,
-        });
-    }
+    index.iter().for_each(|&j| seen[j] = true);
+    let base = left_out_joints(pipeline, &seen)?;
     let mut q = Vec::with_capacity(points.len());
     let mut t = Vec::with_capacity(points.len());
     for (k, point) in points.iter().enumerate() {
@@ -173,6 +124,62 @@ fn resolve(pipeline: &Pipeline, trajectory: &JointTrajectory) -> Result<Plan, St
         t.push(tk);
     }
     Ok(Plan { q, t })
+}
+
+/// The joint index of every name; unknown and repeated names refused (a few unknown ones quoted,
+/// the rest counted).
+fn joint_indices(robot: &crate::model::RobotModel, names: &[String]) -> Result<Vec<usize>, String> {
+    let mut index = Vec::with_capacity(names.len());
+    let mut seen = vec![false; robot.joints.len()];
+    let (mut unknown, mut unknown_count): (Vec<String>, usize) = (Vec::new(), 0);
+    for name in names {
+        match robot.joint(name) {
+            Some(j) if seen[j] => return Err(format!("joint_names gives joint '{name}' twice")),
+            Some(j) => {
+                seen[j] = true;
+                index.push(j);
+            }
+            None => {
+                unknown_count += 1;
+                if unknown.len() < MAX_NAMES_IN_ERROR {
+                    unknown.push(format!("'{name}'"));
+                }
+            }
+        }
+    }
+    if unknown_count > 0 {
+        let more = if unknown_count > unknown.len() { format!(" and {} more", unknown_count - unknown.len()) } else { String::new() };
+        let what = if unknown_count == 1 { "is not a joint" } else { "are not joints" };
+        return Err(format!("joint_names: {}{more} {what} of the robot model", unknown.join(", ")));
+    }
+    Ok(index)
+}
+
+/// The positions of the joints a trajectory leaves out (`named[j]` false): the current merged
+/// state, else the missing_joint rule.
+fn left_out_joints(pipeline: &Pipeline, named: &[bool]) -> Result<Vec<f64>, String> {
+    let missing = pipeline.params().missing_joint;
+    let robot = pipeline.checker().robot();
+    let mut base = Vec::with_capacity(robot.joints.len());
+    for (ji, ((joint, current), named)) in robot.joints.iter().zip(pipeline.current_joints()).zip(named).enumerate() {
+        base.push(match current {
+            _ if *named => 0.0,
+            Some(v) => *v,
+            None if joint.is_actuated() && missing == MissingJoint::Reject => {
+                return Err(format!("joint '{}' is neither in joint_names nor in a joint state received so far (missing_joint: reject)", joint.name))
+            }
+            // Under `last` an unknown joint that moves a checked link leaves the robot's pose
+            // unknown: checking it at 0 could call a colliding trajectory free.
+            None if missing == MissingJoint::Last && pipeline.checker().moves_checked_link(ji) => {
+                return Err(format!(
+                    "joint '{}' is neither in joint_names nor in a joint state received so far (missing_joint: last takes it from the joint states)",
+                    joint.name
+                ))
+            }
+            None => 0.0,
+        });
+    }
+    Ok(base)
 }
 
 /// `t0 + fraction (t1 - t0)` rounded down to the nanosecond (never later than the contact), as a
