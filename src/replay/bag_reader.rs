@@ -14,95 +14,11 @@
 //!   decompressed as [`super::bag_compression`] describes, within the same bounds.
 
 use super::bag_compression::{compression_from_metadata, decompress_message, message_context, Compression, MessageContext, Scratch, MAX_FILE_BYTES};
-use mcap::read::ChannelAccumulator;
-use mcap::records::{op, Record};
-use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
-use mcap::McapError;
-use std::collections::{HashMap, HashSet};
-use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom};
+use super::bag_mcap::{mcap_topics, McapStream};
+use super::bag_sqlite::{sqlite_topics, SqliteStream};
+pub use super::bag_types::{BagError, BagMessage, MAX_RECORD_BYTES};
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
-use std::sync::{Arc, Condvar, Mutex};
-use std::thread::JoinHandle;
-
-/// The longest record (MCAP) or message (sqlite3) this reader accepts: 256 MiB. A longer one is a
-/// corrupt length, or a message this replay has no use for; either way an error naming the file
-/// and the length, not an allocation of that size.
-pub const MAX_RECORD_BYTES: usize = 256 << 20;
-/// Bytes asked of the file at a time (the MCAP reader's buffer grows by at most this much more
-/// than the data it holds).
-const READ_PIECE: usize = 256 << 10;
-/// The `BufReader` over an MCAP file.
-const FILE_BUFFER: usize = 64 << 10;
-/// Messages queued between the sqlite3 reader thread and the iterator.
-pub const SQLITE_QUEUE: usize = 256;
-/// Payload bytes queued between the sqlite3 reader thread and the iterator (one larger message
-/// still passes, alone).
-pub const SQLITE_QUEUE_BYTES: usize = 16 << 20;
-
-/// One recorded message.
-#[derive(Clone, Debug)]
-pub struct BagMessage {
-    /// Topic.
-    pub topic: String,
-    /// ROS type, e.g. `sensor_msgs/msg/JointState`.
-    pub type_name: String,
-    /// Receive time (nanoseconds since the epoch).
-    pub log_time: i64,
-    /// Serialized payload (CDR with its encapsulation header).
-    pub data: Vec<u8>,
-}
-
-/// A bag that cannot be read (the whole bag, or from some point on).
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum BagError {
-    /// The file cannot be read.
-    #[error("cannot read bag {0}: {1}")]
-    Io(PathBuf, std::io::Error),
-    /// Not a directory with metadata.yaml, an .mcap or a .db3 file (or one compressed as .zstd).
-    #[error("{0}: unknown storage format (expected a rosbag2 directory with metadata.yaml, an .mcap file or a .db3 file, or such a file compressed as .zstd)")]
-    UnknownFormat(PathBuf),
-    /// metadata.yaml is malformed or names a storage this reader does not know.
-    #[error("{0}/metadata.yaml: {1}")]
-    Metadata(PathBuf, String),
-    /// The MCAP file is corrupt or truncated (after the given number of messages of that file).
-    #[error("{path}: corrupt or truncated MCAP after {after} messages: {message}")]
-    Mcap {
-        /// File.
-        path: PathBuf,
-        /// Messages of this file read before the fault.
-        after: usize,
-        /// What the reader said.
-        message: String,
-    },
-    /// The sqlite3 file is corrupt or not a rosbag2 database.
-    #[error("{path}: sqlite3 bag error after {after} messages: {message}")]
-    Sqlite {
-        /// File.
-        path: PathBuf,
-        /// Messages of this file read before the fault.
-        after: usize,
-        /// What SQLite said.
-        message: String,
-    },
-    /// A compressed file or message payload that cannot be decompressed within the bounds.
-    #[error("{0}: {1}")]
-    Decompress(PathBuf, String),
-}
-
-impl BagError {
-    /// The same error naming `shown` (the `.zstd` file) instead of its decompressed copy.
-    fn shown_as(self, shown: &Path) -> Self {
-        match self {
-            BagError::Io(_, e) => BagError::Io(shown.to_owned(), e),
-            BagError::Mcap { after, message, .. } => BagError::Mcap { path: shown.to_owned(), after, message },
-            BagError::Sqlite { after, message, .. } => BagError::Sqlite { path: shown.to_owned(), after, message },
-            other => other,
-        }
-    }
-}
 
 /// A storage file: where it is read, and how errors name it (they differ for a decompressed copy).
 #[derive(Clone, Debug)]
@@ -255,73 +171,8 @@ fn message_context_of(slot: &mut Option<MessageContext>) -> Result<&mut MessageC
 /// Opens a bag: checks the files, reads the topics, reads no messages (iterate for those). A
 /// file-compressed bag is decompressed here, every file, into the temporary folder.
 pub fn open_bag(path: &Path) -> Result<BagReader, BagError> {
-    let (storage, compression, files) = if path.is_dir() {
-        let meta_path = path.join("metadata.yaml");
-        if !meta_path.exists() {
-            return Err(BagError::UnknownFormat(path.to_owned()));
-        }
-        let text = crate::limits::read_regular_text(&meta_path, "bag metadata", crate::limits::MAX_DESCRIPTION_BYTES)
-            .map_err(|e| BagError::Metadata(path.to_owned(), e.to_string()))?;
-        let meta: serde_yaml_ng::Value = serde_yaml_ng::from_str(&text).map_err(|e| BagError::Metadata(path.to_owned(), e.to_string()))?;
-        let info = &meta["rosbag2_bagfile_information"];
-        let files: Vec<PathBuf> =
-            info["relative_file_paths"].as_sequence().map(|s| s.iter().filter_map(|f| f.as_str()).map(|f| path.join(f)).collect()).unwrap_or_default();
-        if files.is_empty() {
-            return Err(BagError::Metadata(path.to_owned(), "relative_file_paths is empty or missing".into()));
-        }
-        for (i, f) in files.iter().enumerate() {
-            let rel = f.strip_prefix(path).unwrap_or(f);
-            if rel.components().any(|c| !matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir)) {
-                return Err(BagError::Metadata(path.to_owned(), format!("relative_file_paths: '{}' leaves the bag directory", rel.display())));
-            }
-            if files[..i].contains(f) {
-                return Err(BagError::Metadata(path.to_owned(), format!("relative_file_paths lists '{}' twice", rel.display())));
-            }
-        }
-        let storage = match info["storage_identifier"].as_str().unwrap_or("") {
-            "mcap" => Storage::Mcap,
-            "sqlite3" => Storage::Sqlite,
-            other => return Err(BagError::Metadata(path.to_owned(), format!("unknown storage_identifier '{other}' (expected mcap or sqlite3)"))),
-        };
-        let compression = compression_from_metadata(info).map_err(|e| BagError::Metadata(path.to_owned(), e))?;
-        (storage, compression, files)
-    } else {
-        let (inner, compression) = match path.extension().and_then(|e| e.to_str()) {
-            Some("zstd") => (path.file_stem().map(Path::new).and_then(|s| s.extension()).and_then(|e| e.to_str()), Compression::File),
-            e => (e, Compression::None),
-        };
-        match inner {
-            Some("mcap") => (Storage::Mcap, compression, vec![path.to_owned()]),
-            Some("db3") => (Storage::Sqlite, compression, vec![path.to_owned()]),
-            _ if !path.exists() => return Err(BagError::Io(path.to_owned(), std::io::Error::from(std::io::ErrorKind::NotFound))),
-            _ => return Err(BagError::UnknownFormat(path.to_owned())),
-        }
-    };
-    // File compression: rosbag2 names each file `<file>.zstd`; such a name is decompressed even
-    // when metadata.yaml does not say so (a file compressed by hand).
-    let mut scratch = None;
-    let files = files
-        .into_iter()
-        .map(|f| {
-            if compression != Compression::File && f.extension().is_none_or(|e| e != "zstd") {
-                return Ok(BagFile { read: f.clone(), shown: f });
-            }
-            if !f.exists() {
-                return Err(BagError::Io(f, std::io::Error::from(std::io::ErrorKind::NotFound)));
-            }
-            let s = match &mut scratch {
-                Some(s) => s,
-                None => {
-                    let tmp = std::env::temp_dir();
-                    let s = Scratch::create(&tmp)
-                        .map_err(|e| BagError::Decompress(f.clone(), format!("cannot make a folder in {} to decompress it into: {e}", tmp.display())))?;
-                    scratch.insert(s)
-                }
-            };
-            let read = s.decompress(&f, MAX_FILE_BYTES).map_err(|e| BagError::Decompress(f.clone(), e))?;
-            Ok(BagFile { read, shown: PathBuf::from(format!("{} (decompressed)", f.display())) })
-        })
-        .collect::<Result<Vec<_>, BagError>>()?;
+    let (storage, compression, files) = if path.is_dir() { directory_files(path)? } else { single_file(path)? };
+    let (files, scratch) = decompressed(files, compression)?;
     let mut topics = Vec::new();
     let mut encodings = Vec::new();
     let mut seen = HashSet::new();
@@ -362,460 +213,90 @@ pub fn open_bag(path: &Path) -> Result<BagReader, BagError> {
     })
 }
 
-// ---------------------------------------------------------------------------------------------
-// MCAP
-
-/// (topic, type, message encoding) triples.
-type Topics = Vec<(String, String, String)>;
-
-/// Why a pass over an MCAP file stopped early.
-enum Fault {
-    Io(std::io::Error),
-    Mcap(McapError),
-    Bad(String),
-}
-
-impl From<McapError> for Fault {
-    fn from(e: McapError) -> Self {
-        Fault::Mcap(e)
+/// A rosbag2 directory: its storage, compression and files from `metadata.yaml`, each file inside
+/// the directory and listed once.
+fn directory_files(path: &Path) -> Result<(Storage, Compression, Vec<PathBuf>), BagError> {
+    let meta_path = path.join("metadata.yaml");
+    if !meta_path.exists() {
+        return Err(BagError::UnknownFormat(path.to_owned()));
     }
-}
-
-impl Fault {
-    fn into_bag_error(self, path: &Path, after: usize) -> BagError {
-        let message = match self {
-            Fault::Io(e) => return BagError::Io(path.to_owned(), e),
-            Fault::Mcap(McapError::RecordTooLarge { opcode, len }) => {
-                format!("a record (opcode {opcode:#04x}) claims {len} bytes, more than this reader's limit of {} MiB per record", MAX_RECORD_BYTES >> 20)
-            }
-            Fault::Mcap(McapError::ChunkTooLarge(len)) => {
-                format!("a chunk claims {len} bytes, more than this reader's limit of {} MiB per record", MAX_RECORD_BYTES >> 20)
-            }
-            Fault::Mcap(e) => match std::error::Error::source(&e) {
-                Some(s) => format!("{e}: {s}"),
-                None => e.to_string(),
-            },
-            Fault::Bad(s) => s,
-        };
-        BagError::Mcap { path: path.to_owned(), after, message }
+    let text = crate::limits::read_regular_text(&meta_path, "bag metadata", crate::limits::MAX_DESCRIPTION_BYTES)
+        .map_err(|e| BagError::Metadata(path.to_owned(), e.to_string()))?;
+    let meta: serde_yaml_ng::Value = serde_yaml_ng::from_str(&text).map_err(|e| BagError::Metadata(path.to_owned(), e.to_string()))?;
+    let info = &meta["rosbag2_bagfile_information"];
+    let files: Vec<PathBuf> =
+        info["relative_file_paths"].as_sequence().map(|s| s.iter().filter_map(|f| f.as_str()).map(|f| path.join(f)).collect()).unwrap_or_default();
+    if files.is_empty() {
+        return Err(BagError::Metadata(path.to_owned(), "relative_file_paths is empty or missing".into()));
     }
-}
-
-/// Feeds an MCAP file to the sans-io linear reader, a bounded piece at a time.
-struct Pump {
-    src: BufReader<File>,
-    reader: LinearReader,
-}
-
-impl Pump {
-    fn new(file: File, options: LinearReaderOptions) -> Self {
-        Pump { src: BufReader::with_capacity(FILE_BUFFER, file), reader: LinearReader::new_with_options(options) }
-    }
-
-    /// Hands the records to `on` until it returns `Some`; `Ok(None)` at the clean end of the file.
-    fn next_record<T>(&mut self, mut on: impl FnMut(u8, &[u8]) -> Result<Option<T>, Fault>) -> Result<Option<T>, Fault> {
-        loop {
-            // mcap 0.26's LinearReader subtracts a record's length from its chunk's remaining
-            // size unchecked (`linear_reader.rs:745`): a record inside an uncompressed chunk that
-            // claims more bytes than the chunk has panics with overflow checks on (debug builds;
-            // found by `cargo fuzz`, fuzz/regressions/bag_mcap/). Contained, the file ends there
-            // with an error like any other corrupt MCAP.
-            let reader = &mut self.reader;
-            // (The reader moves into the closure, so the event may borrow it past the call.)
-            let event = crate::limits::contain_panic(move || {
-                let reader = reader;
-                reader.next_event()
-            })
-            .map_err(|panic| Fault::Bad(format!("the mcap crate failed on this file ({panic})")))?;
-            let want = match event {
-                None => return Ok(None),
-                Some(Err(e)) => return Err(Fault::Mcap(e)),
-                Some(Ok(LinearReadEvent::ReadRequest(n))) => n,
-                Some(Ok(LinearReadEvent::Record { opcode, data })) => {
-                    if let Some(t) = on(opcode, data)? {
-                        return Ok(Some(t));
-                    }
-                    continue;
-                }
-            };
-            // Never more than READ_PIECE at once: the reader's buffer is sized by the request, and
-            // a corrupt length must not size it beyond the bytes the file really has.
-            let buf = self.reader.insert(want.clamp(1, READ_PIECE));
-            let n = loop {
-                match self.src.read(buf) {
-                    Ok(n) => break n,
-                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                    Err(e) => return Err(Fault::Io(e)),
-                }
-            };
-            self.reader.notify_read(n);
+    for (i, f) in files.iter().enumerate() {
+        let rel = f.strip_prefix(path).unwrap_or(f);
+        if rel.components().any(|c| !matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir)) {
+            return Err(BagError::Metadata(path.to_owned(), format!("relative_file_paths: '{}' leaves the bag directory", rel.display())));
+        }
+        if files[..i].contains(f) {
+            return Err(BagError::Metadata(path.to_owned(), format!("relative_file_paths lists '{}' twice", rel.display())));
         }
     }
-}
-
-/// Checks that the length-prefixed strings of a schema or channel record fit in the record before
-/// the `mcap` crate parses it (its parser reserves a string's claimed length up front: up to 4 GiB
-/// from one corrupt u32).
-fn check_strings(opcode: u8, body: &[u8]) -> Result<(), Fault> {
-    fn string(body: &[u8], pos: &mut usize, end: usize) -> Option<()> {
-        let len = u32::from_le_bytes(body.get(*pos..*pos + 4)?.try_into().ok()?) as usize;
-        *pos = pos.checked_add(4)?.checked_add(len)?;
-        (*pos <= end).then_some(())
-    }
-    let ok = || -> Option<()> {
-        let mut pos = match opcode {
-            op::SCHEMA => 2,
-            op::CHANNEL => 4,
-            _ => return Some(()),
-        };
-        string(body, &mut pos, body.len())?;
-        string(body, &mut pos, body.len())?;
-        if opcode == op::CHANNEL {
-            let map_len = u32::from_le_bytes(body.get(pos..pos + 4)?.try_into().ok()?) as usize;
-            pos += 4;
-            let end = pos.checked_add(map_len)?;
-            if end > body.len() {
-                return None;
-            }
-            while pos < end {
-                string(body, &mut pos, end)?;
-                string(body, &mut pos, end)?;
-            }
-        }
-        Some(())
+    let storage = match info["storage_identifier"].as_str().unwrap_or("") {
+        "mcap" => Storage::Mcap,
+        "sqlite3" => Storage::Sqlite,
+        other => return Err(BagError::Metadata(path.to_owned(), format!("unknown storage_identifier '{other}' (expected mcap or sqlite3)"))),
     };
-    ok().ok_or_else(|| Fault::Bad(format!("a {} record's strings overrun its {} bytes", if opcode == op::SCHEMA { "schema" } else { "channel" }, body.len())))
+    let compression = compression_from_metadata(info).map_err(|e| BagError::Metadata(path.to_owned(), e))?;
+    Ok((storage, compression, files))
 }
 
-/// Schemas and channels as declared, for the topic list (lenient: no cross-checks, which the
-/// message pass does).
-#[derive(Default)]
-struct Declared {
-    schemas: HashMap<u16, String>,
-    channel_ids: HashSet<u16>,
-    channels: Vec<(String, u16, String)>,
+/// One storage file given directly, by its extension (`.mcap`, `.db3`, either with `.zstd`).
+fn single_file(path: &Path) -> Result<(Storage, Compression, Vec<PathBuf>), BagError> {
+    let (inner, compression) = match path.extension().and_then(|e| e.to_str()) {
+        Some("zstd") => (path.file_stem().map(Path::new).and_then(|s| s.extension()).and_then(|e| e.to_str()), Compression::File),
+        e => (e, Compression::None),
+    };
+    match inner {
+        Some("mcap") => Ok((Storage::Mcap, compression, vec![path.to_owned()])),
+        Some("db3") => Ok((Storage::Sqlite, compression, vec![path.to_owned()])),
+        _ if !path.exists() => Err(BagError::Io(path.to_owned(), std::io::Error::from(std::io::ErrorKind::NotFound))),
+        _ => Err(BagError::UnknownFormat(path.to_owned())),
+    }
 }
 
-impl Declared {
-    fn add(&mut self, opcode: u8, body: &[u8]) -> Result<(), Fault> {
-        if opcode != op::SCHEMA && opcode != op::CHANNEL {
-            return Ok(());
-        }
-        check_strings(opcode, body)?;
-        match mcap::parse_record(opcode, body)? {
-            Record::Schema { header, .. } => {
-                let _ = self.schemas.entry(header.id).or_insert(header.name);
+/// The files to read: a compressed one decompressed into a scratch folder (rosbag2 names each
+/// `<file>.zstd`; such a name is decompressed even when metadata.yaml does not say so, a file
+/// compressed by hand).
+fn decompressed(files: Vec<PathBuf>, compression: Compression) -> Result<(Vec<BagFile>, Option<Scratch>), BagError> {
+    let mut scratch = None;
+    let files = files
+        .into_iter()
+        .map(|f| {
+            if compression != Compression::File && f.extension().is_none_or(|e| e != "zstd") {
+                return Ok(BagFile { read: f.clone(), shown: f });
             }
-            Record::Channel(c) if self.channel_ids.insert(c.id) => self.channels.push((c.topic, c.schema_id, c.message_encoding)),
-            _ => {}
-        }
-        Ok(())
-    }
-
-    fn topics(self) -> Topics {
-        let schemas = self.schemas;
-        self.channels.into_iter().map(|(topic, schema, encoding)| (topic, schemas.get(&schema).cloned().unwrap_or_default(), encoding)).collect()
-    }
-}
-
-/// A bag file opened only when it is a regular file (a FIFO would block, a device never end).
-fn open_bag_file(path: &Path) -> Result<File, BagError> {
-    crate::limits::open_regular(path, "bag file", u64::MAX).map(|(f, _)| f).map_err(|e| match e {
-        crate::limits::InputFileError::Io { error, .. } => BagError::Io(path.to_owned(), error),
-        other => BagError::Io(path.to_owned(), std::io::Error::other(other.to_string())),
-    })
-}
-
-/// The topics of an MCAP file, and the fault that cut the scan short when there was no summary.
-fn mcap_topics(path: &Path) -> Result<(Topics, Option<BagError>), BagError> {
-    let io = |e| BagError::Io(path.to_owned(), e);
-    let file = open_bag_file(path)?;
-    let size = file.metadata().map_err(io)?.len();
-    if let Some(topics) = summary_topics(file, size) {
-        return Ok((topics, None));
-    }
-    // No usable summary: one pass over the channel records (data bytes are skipped, but chunks
-    // have to be decompressed to find the records in them).
-    let mut pump = Pump::new(open_bag_file(path)?, LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES));
-    let mut declared = Declared::default();
-    let (mut records, mut messages) = (0usize, 0usize);
-    let scan = pump.next_record(|opcode, body| {
-        records += 1;
-        match opcode {
-            op::DATA_END => return Ok(Some(())),
-            op::MESSAGE => messages += 1,
-            _ => declared.add(opcode, body)?,
-        }
-        Ok(None)
-    });
-    match scan {
-        Ok(_) => Ok((declared.topics(), None)),
-        // Not even the header: not an MCAP file (or an empty one).
-        Err(e) if records == 0 => Err(e.into_bag_error(path, 0)),
-        Err(e) => Ok((declared.topics(), Some(e.into_bag_error(path, messages)))),
-    }
-}
-
-/// The topics from the summary section, or `None` when there is no usable one.
-fn summary_topics(mut file: File, size: u64) -> Option<Topics> {
-    // Footer record (opcode, length, summary start, summary offset start, CRC) and end magic.
-    const TAIL: usize = 1 + 8 + 8 + 8 + 4 + 8;
-    let magic = mcap::MAGIC.len() as u64;
-    if size < magic + TAIL as u64 {
-        return None;
-    }
-    let footer_at = size - TAIL as u64;
-    let _ = file.seek(SeekFrom::Start(footer_at)).ok()?;
-    let mut tail = [0u8; TAIL];
-    file.read_exact(&mut tail).ok()?;
-    let field = |at: usize| tail.get(at..at + 8).and_then(|b| b.try_into().ok()).map(u64::from_le_bytes);
-    if tail[0] != op::FOOTER || field(1)? != 20 || &tail[TAIL - 8..] != mcap::MAGIC {
-        return None;
-    }
-    let summary_start = field(9)?;
-    if summary_start < magic || summary_start >= footer_at {
-        return None;
-    }
-    let _ = file.seek(SeekFrom::Start(summary_start)).ok()?;
-    let limit = usize::try_from(footer_at - summary_start).unwrap_or(usize::MAX).min(MAX_RECORD_BYTES);
-    let mut pump = Pump::new(file, LinearReaderOptions::default().with_skip_start_magic(true).with_record_length_limit(limit));
-    let mut declared = Declared::default();
-    let end = pump.next_record(|opcode, body| {
-        if opcode == op::FOOTER {
-            return Ok(Some(()));
-        }
-        declared.add(opcode, body)?;
-        Ok(None)
-    });
-    // A summary that does not run into the footer, or lists no channels, is not used.
-    (matches!(end, Ok(Some(()))) && !declared.channels.is_empty()).then(|| declared.topics())
-}
-
-/// The messages of one MCAP file.
-struct McapStream {
-    path: PathBuf,
-    pump: Pump,
-    channels: ChannelAccumulator<'static>,
-    past_data_end: bool,
-    read: usize,
-}
-
-impl McapStream {
-    fn open(path: &Path) -> Result<Self, BagError> {
-        let file = open_bag_file(path)?;
-        let options = LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES).with_validate_chunk_crcs(true);
-        Ok(McapStream { path: path.to_owned(), pump: Pump::new(file, options), channels: ChannelAccumulator::default(), past_data_end: false, read: 0 })
-    }
-
-    fn next(&mut self) -> Option<Result<BagMessage, BagError>> {
-        let Self { pump, channels, past_data_end, .. } = self;
-        // Read on to the end magic after the data end record (the summary is skipped, not parsed),
-        // so that a truncated tail is reported.
-        let next = pump.next_record(|opcode, body| {
-            if *past_data_end {
-                return if opcode == op::MESSAGE { Err(Fault::Bad("a message record after the data end record".into())) } else { Ok(None) };
+            if !f.exists() {
+                return Err(BagError::Io(f, std::io::Error::from(std::io::ErrorKind::NotFound)));
             }
-            match opcode {
-                op::DATA_END => *past_data_end = true,
-                op::SCHEMA | op::CHANNEL => {
-                    check_strings(opcode, body)?;
-                    match mcap::parse_record(opcode, body)? {
-                        Record::Schema { header, data } => channels.add_schema_from_slice(header, &data)?,
-                        Record::Channel(c) => channels.add_channel(c)?,
-                        _ => {}
-                    }
+            let s = match &mut scratch {
+                Some(s) => s,
+                None => {
+                    let tmp = std::env::temp_dir();
+                    let s = Scratch::create(&tmp)
+                        .map_err(|e| BagError::Decompress(f.clone(), format!("cannot make a folder in {} to decompress it into: {e}", tmp.display())))?;
+                    scratch.insert(s)
                 }
-                op::MESSAGE => {
-                    if let Record::Message { header, data } = mcap::parse_record(opcode, body)? {
-                        let channel = channels.get(header.channel_id).ok_or(McapError::UnknownChannel(header.sequence, header.channel_id))?;
-                        return Ok(Some(BagMessage {
-                            topic: channel.topic.clone(),
-                            type_name: channel.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default(),
-                            log_time: i64::try_from(header.log_time).unwrap_or(i64::MAX),
-                            data: data.into_owned(),
-                        }));
-                    }
-                }
-                _ => {}
-            }
-            Ok(None)
-        });
-        match next {
-            Ok(Some(m)) => {
-                self.read += 1;
-                Some(Ok(m))
-            }
-            Ok(None) => None,
-            Err(e) => Some(Err(e.into_bag_error(&self.path, self.read))),
-        }
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
-// sqlite3
-
-fn sqlite_open(path: &Path) -> Result<rusqlite::Connection, BagError> {
-    if !path.is_file() {
-        return Err(BagError::Io(path.to_owned(), std::io::Error::from(std::io::ErrorKind::NotFound)));
-    }
-    rusqlite::Connection::open_with_flags(path, rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY | rusqlite::OpenFlags::SQLITE_OPEN_NO_MUTEX)
-        .map_err(|e| BagError::Sqlite { path: path.to_owned(), after: 0, message: e.to_string() })
-}
-
-fn sqlite_topic_rows(db: &rusqlite::Connection) -> rusqlite::Result<Vec<(i64, String, String, String)>> {
-    let mut stmt = db.prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id")?;
-    let rows = stmt.query_map([], |r| Ok((r.get::<_, i64>(0)?, r.get::<_, String>(1)?, r.get::<_, String>(2)?, r.get::<_, String>(3)?)))?;
-    rows.collect()
-}
-
-fn sqlite_topics(path: &Path) -> Result<Topics, BagError> {
-    let db = sqlite_open(path)?;
-    let rows = sqlite_topic_rows(&db).map_err(|e| BagError::Sqlite { path: path.to_owned(), after: 0, message: e.to_string() })?;
-    Ok(rows.into_iter().map(|(_, name, ty, encoding)| (name, ty, encoding)).collect())
-}
-
-/// What the sqlite3 reader thread sends.
-enum Row {
-    Message(BagMessage),
-    Fault(String),
-    End,
-}
-
-/// The byte budget of the queue: the thread waits while more than SQLITE_QUEUE_BYTES are queued.
-#[derive(Default)]
-struct Flow {
-    state: Mutex<FlowState>,
-    cv: Condvar,
-}
-
-#[derive(Default)]
-struct FlowState {
-    bytes: usize,
-    closed: bool,
-}
-
-impl Flow {
-    /// Waits for room for `n` bytes; false once the iterator is gone.
-    fn acquire(&self, n: usize) -> bool {
-        let Ok(mut s) = self.state.lock() else { return false };
-        while !s.closed && s.bytes > 0 && s.bytes.saturating_add(n) > SQLITE_QUEUE_BYTES {
-            s = match self.cv.wait(s) {
-                Ok(s) => s,
-                Err(_) => return false,
             };
-        }
-        if s.closed {
-            return false;
-        }
-        s.bytes += n;
-        true
-    }
-
-    fn release(&self, n: usize) {
-        if let Ok(mut s) = self.state.lock() {
-            s.bytes = s.bytes.saturating_sub(n);
-        }
-        self.cv.notify_one();
-    }
-
-    fn close(&self) {
-        if let Ok(mut s) = self.state.lock() {
-            s.closed = true;
-        }
-        self.cv.notify_all();
-    }
-}
-
-/// The messages of one sqlite3 file, read row by row by a thread that owns the connection.
-struct SqliteStream {
-    path: PathBuf,
-    rx: Option<Receiver<Row>>,
-    flow: Arc<Flow>,
-    thread: Option<JoinHandle<()>>,
-    read: usize,
-}
-
-impl SqliteStream {
-    fn start(path: &Path) -> Result<Self, BagError> {
-        let db = sqlite_open(path)?;
-        let (tx, rx) = sync_channel(SQLITE_QUEUE);
-        let flow = Arc::new(Flow::default());
-        let thread = {
-            let flow = Arc::clone(&flow);
-            std::thread::Builder::new()
-                .name("bag-sqlite3".into())
-                .spawn(move || {
-                    let last = match send_rows(&db, &tx, &flow) {
-                        Ok(true) => Row::End,
-                        Ok(false) => return, // the iterator is gone
-                        Err(e) => Row::Fault(e),
-                    };
-                    let _ = tx.send(last);
-                })
-                .map_err(|e| BagError::Io(path.to_owned(), e))?
-        };
-        Ok(SqliteStream { path: path.to_owned(), rx: Some(rx), flow, thread: Some(thread), read: 0 })
-    }
-
-    fn next(&mut self) -> Option<Result<BagMessage, BagError>> {
-        let row = self.rx.as_ref()?.recv();
-        let fault = match row {
-            Ok(Row::Message(m)) => {
-                self.flow.release(m.data.len());
-                self.read += 1;
-                return Some(Ok(m));
-            }
-            Ok(Row::End) => None,
-            Ok(Row::Fault(message)) => Some(message),
-            Err(_) => Some("the sqlite3 reader thread stopped without finishing".to_owned()),
-        };
-        self.rx = None;
-        fault.map(|message| Err(BagError::Sqlite { path: self.path.clone(), after: self.read, message }))
-    }
-}
-
-impl Drop for SqliteStream {
-    fn drop(&mut self) {
-        // Unblock the thread wherever it waits (byte budget or a full queue), then wait for it so
-        // that the connection is closed when the reader is.
-        self.flow.close();
-        self.rx = None;
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
-        }
-    }
-}
-
-/// The reader thread: every row in timestamp order. Ok(false) when the iterator went away.
-fn send_rows(db: &rusqlite::Connection, tx: &SyncSender<Row>, flow: &Flow) -> Result<bool, String> {
-    let topics: HashMap<i64, (String, String)> =
-        sqlite_topic_rows(db).map_err(|e| e.to_string())?.into_iter().map(|(id, name, ty, _)| (id, (name, ty))).collect();
-    let mut stmt = db.prepare("SELECT topic_id, timestamp, length(data), data FROM messages ORDER BY timestamp, id").map_err(|e| e.to_string())?;
-    let mut rows = stmt.query([]).map_err(|e| e.to_string())?;
-    while let Some(row) = rows.next().map_err(|e| e.to_string())? {
-        let tid: i64 = row.get(0).map_err(|e| e.to_string())?;
-        let log_time: i64 = row.get(1).map_err(|e| e.to_string())?;
-        // length() reads the record header only: a long blob is refused before it is loaded.
-        let len: Option<i64> = row.get(2).map_err(|e| e.to_string())?;
-        if len.is_some_and(|n| usize::try_from(n).map_or(true, |n| n > MAX_RECORD_BYTES)) {
-            return Err(format!(
-                "the message at {log_time} ns has {} bytes, more than this reader's limit of {} MiB per message",
-                len.unwrap_or_default(),
-                MAX_RECORD_BYTES >> 20
-            ));
-        }
-        let data: Vec<u8> = row.get(3).map_err(|e| e.to_string())?;
-        let (topic, type_name) = topics.get(&tid).cloned().unwrap_or_else(|| (format!("<unknown topic id {tid}>"), String::new()));
-        if !flow.acquire(data.len()) || tx.send(Row::Message(BagMessage { topic, type_name, log_time, data })).is_err() {
-            return Ok(false);
-        }
-    }
-    Ok(true)
+            let read = s.decompress(&f, MAX_FILE_BYTES).map_err(|e| BagError::Decompress(f.clone(), e))?;
+            Ok(BagFile { read, shown: PathBuf::from(format!("{} (decompressed)", f.display())) })
+        })
+        .collect::<Result<Vec<_>, BagError>>()?;
+    Ok((files, scratch))
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::bag_mcap::check_strings;
     use super::*;
+
+    use mcap::records::{op, Record};
     use std::collections::BTreeMap;
     use std::io::Cursor;
 

@@ -3,8 +3,11 @@
 //! bag with the `collisions` topic, markers and the robot for viewers, and/or as a timeline SVG.
 
 mod bag_compression;
+mod bag_mcap;
 mod bag_output;
 mod bag_reader;
+mod bag_sqlite;
+mod bag_types;
 mod bag_writer;
 mod cdr;
 mod cdr_writer;
