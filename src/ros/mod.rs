@@ -9,14 +9,18 @@
 
 mod diagnostics;
 mod discovery_range;
+mod interfaces;
 mod memory_return;
 mod msg_impls;
 mod node_run;
+mod node_state;
 mod param_services;
 mod param_values;
+mod participant;
+mod rate_limited_log;
 mod ros_args;
 mod states_on_receive;
-mod validity_worker;
+mod workers;
 
 pub use self::node_run::{run, RunOptions};
 pub use self::ros_args::{parse_ros_args, RosArgs};
