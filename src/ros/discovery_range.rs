@@ -11,7 +11,7 @@
 //! | range `OFF` | loopback only, no SPDP announcement sent, every other participant's ignored: the node discovers nothing, even on the same host; static peers ignored (OFF wins, as in the ROS 2 docs) |
 //!
 //! A static peer is announced to by unicast SPDP at the well-known discovery ports of the first
-//! 12 participant ids of the domain (the patched RustDDS, `vendor/rustdds/PATCHES.md` change 6);
+//! 12 participant ids of the domain (the patched RustDDS, `vendor/rustdds/PATCHES.md`, "Static SPDP peers");
 //! once it answers, it is matched like any multicast-discovered participant. `LOCALHOST` with
 //! static peers (rmw: loopback plus those hosts, no multicast) is refused at start: RustDDS
 //! cannot keep multicast off while advertising a non-loopback address, and advertising only

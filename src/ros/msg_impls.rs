@@ -1,8 +1,9 @@
 //! The shared message types are ROS messages for ros2-client, and the node's own: the
 //! `check_states` service, `/clock`, and `robot_description` decoded with its size bound (the
-//! `check_trajectory` types live in `msgs`, beside the trajectory they carry).
+//! `check_trajectory` and `check_state_validity` types live in `msgs`, beside what they carry).
 
 use crate::limits::MAX_DESCRIPTION_BYTES;
+use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, StringMsg, TfMessage};
 use serde::{Deserialize, Serialize};
 
@@ -14,6 +15,8 @@ impl ros2_client::Message for MarkerArray {}
 impl ros2_client::Message for DiagnosticArray {}
 impl ros2_client::Message for CheckTrajectoryRequest {}
 impl ros2_client::Message for CheckTrajectoryResponse {}
+impl ros2_client::Message for GetStateValidityRequest {}
+impl ros2_client::Message for GetStateValidityResponse {}
 
 /// `thickness_collision_msgs/srv/CheckStates` request.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]

@@ -1,9 +1,10 @@
 //! The node's parameters as ROS 2 parameter values: declared from [`Params::flat`], and a value
 //! set through the parameter services turned back into typed parameters.
 
-use crate::model::Params;
-use ros2_client::ParameterValue;
+use crate::model::{Params, ServiceMapping};
+use ros2_client::{NodeOptions, ParameterValue};
 use serde_json::Value;
+use std::sync::{Arc, Mutex};
 
 /// Parameters that shape the node's topics and services, fixed once they are created.
 pub const READ_ONLY: [&str; 3] = ["pose_source", "service_mapping", "use_sim_time"];
@@ -55,6 +56,32 @@ pub fn to_json(value: &ParameterValue) -> Value {
         ParameterValue::DoubleArray(a) => Value::Array(a.iter().map(|x| num(*x)).collect()),
         ParameterValue::StringArray(a) => Value::Array(a.iter().map(|x| Value::String(x.clone())).collect()),
     }
+}
+
+/// The node's options: its parameters declared, and where accepted changes go: the
+/// set-parameters service only validates (it runs in the spinner's task); the loop rebuilds.
+pub fn parameter_options(params: &Params, changes: smol::channel::Sender<Params>) -> NodeOptions {
+    let accepted = Arc::new(Mutex::new(params.clone()));
+    let action = move |name: &str, value: &ParameterValue| -> Result<(), String> {
+        let mut current = accepted.lock().map_err(|_| "parameter state poisoned".to_string())?;
+        let fresh = current.with_value(name, to_json(value)).map_err(|e| e.to_string())?;
+        if fresh == *current {
+            return Ok(());
+        }
+        if READ_ONLY.contains(&name) {
+            return Err(format!("parameter '{name}' is read-only while the node runs (it shapes the node's topics)"));
+        }
+        changes.try_send(fresh.clone()).map_err(|_| "the node is shutting down".to_string())?;
+        *current = fresh;
+        Ok(())
+    };
+    // ros2-client serves the parameter services with the enhanced mapping only; with another the
+    // node serves them itself (param_services.rs).
+    let mut options = NodeOptions::new().enable_rosout(true).start_parameter_services(params.service_mapping == ServiceMapping::Enhanced);
+    for (name, value) in declarations(params) {
+        options = options.declare_parameter(&name, value);
+    }
+    options.parameter_set_action(Box::new(action))
 }
 
 #[cfg(test)]

@@ -1,19 +1,20 @@
-//! Joint states answered on the thread that receives them (issue 14).
+//! Joint states answered on the thread that receives them.
 //!
 //! RustDDS reads every sample on its event-loop thread. Handed from there to the node's loop, each
-//! state cost a thread wake-up before it was checked, a hand-over a Fast DDS node does not pay (its
-//! listener answers on the receiving thread). The joint-states reader's waker is an
+//! state would cost a thread wake-up before it was checked, a hand-over a Fast DDS node does not
+//! pay (its listener answers on the receiving thread). The joint-states reader's waker is an
 //! [`OnReceive`]: RustDDS calls it on its event-loop thread once the sample is stored, and when the
 //! node's state is free it takes the waiting states, checks them and publishes the reports right
-//! there (the report leaves from that thread too: RustDDS change 12). When the loop holds the
-//! state (a service request, a tick, a robot being built) or a parameter change is waiting, it
-//! only passes the turn to the loop, which takes the states once it is done: the event loop never
-//! waits for the node and never builds a model.
+//! there (the patched DataWriter sends a new sample from the caller's thread, so the report leaves
+//! from there too). When the loop holds the state (a service request, a tick, a robot being built)
+//! or a parameter change is waiting, it only passes the turn to the loop, which takes the states
+//! once it is done: the event loop never waits for the node and never builds a model.
 //!
-//! `TC_CHECK_ON_RECEIVE=0` in the environment always passes the turn (the hand-over as before),
-//! for measuring one against the other (`benches/run_latency.sh`).
+//! `TC_CHECK_ON_RECEIVE=0` in the environment always passes the turn (every state handed to the
+//! loop), for measuring one against the other (`benches/run_latency.sh`).
 
-use super::node_run::{Interfaces, NodeState, MAX_STATES_PER_TURN};
+use super::interfaces::Interfaces;
+use super::node_state::NodeState;
 use crate::model::Params;
 use crate::msgs::JointState;
 use futures::stream::Stream;
@@ -22,6 +23,11 @@ use std::pin::Pin;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::task::{Context, Poll, Wake, Waker};
+
+/// Joint states taken in one turn at most (of the loop, or of the receiving thread): the rest
+/// wait for the loop's next turn, so a flood cannot keep the loop from a stop request or the
+/// other inputs, nor RustDDS's thread from its other traffic for long.
+const MAX_STATES_PER_TURN: usize = 256;
 
 /// The joint-states reader as a stream that owns its subscription (through the interfaces), so it
 /// can live beside the node's state.
@@ -73,6 +79,11 @@ impl OnReceive {
     /// loop's next turn, so neither thread is held by a flood. `receiving_thread`: called there
     /// (counted for `/diagnostics`), not by the loop.
     pub(super) fn answer_waiting(self: &Arc<Self>, checking: &mut Checking, io: &Interfaces, receiving_thread: bool) {
+        // Polling stores this waker in the reader through the reader's waker lock. On the
+        // receiving thread this runs inside RustDDS's wake of the previous waker: the patched
+        // reader takes the waker out of that lock before waking it (`vendor/rustdds/PATCHES.md`,
+        // "woken outside its lock"), without which this poll would wait on a lock its own thread
+        // holds, and the event loop would stop for good.
         let waker = Waker::from(self.clone());
         let mut cx = Context::from_waker(&waker);
         let mut waiting = Vec::new();
@@ -115,6 +126,9 @@ impl Wake for OnReceive {
         self.wake_by_ref();
     }
 
+    /// Called on RustDDS's event-loop thread once every datagram it read together is stored (the
+    /// patched reader wakes after the batch, not per sample): a node that fell behind finds
+    /// every state that waited, and the oldest can share one report.
     fn wake_by_ref(self: &Arc<Self>) {
         if self.stopped.load(Ordering::SeqCst) {
             return;
