@@ -8,6 +8,7 @@ pub mod example_workcell;
 pub mod mesh_file;
 mod package;
 mod params;
+mod params_file;
 mod robot;
 mod srdf;
 mod xacro;
@@ -15,8 +16,7 @@ pub mod xml_guard;
 
 pub use self::bundled::bundled_config_dir;
 pub use self::package::{PackageError, PackageResolver};
-pub use self::params::{
-    glob_match, node_fqn, LoadedParams, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces, DEFAULT_NODE_FQN,
-};
+pub use self::params::{glob_match, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};
+pub use self::params_file::{node_fqn, LoadedParams, DEFAULT_NODE_FQN};
 pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, PositionsError, RobotModel};
 pub use self::srdf::{Srdf, SrdfError};
