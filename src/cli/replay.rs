@@ -6,7 +6,7 @@ use thickness_collision::replay::{replay as run_replay, ReplayOptions};
 
 pub fn replay(args: &ModelArgs, opts: &ReplayOptions) -> Result<()> {
     let params = super::load::params(args)?;
-    let summary = run_replay(params, args.robot.as_deref(), args.environment.as_deref(), opts)?;
+    let summary = run_replay(params, opts)?;
     println!("{summary}");
     if let Some(e) = &summary.bag_error {
         // The reports before the fault are written; the bag itself is bad.

@@ -16,7 +16,7 @@ pub mod xml_guard;
 pub use self::bundled::bundled_config_dir;
 pub use self::package::{PackageError, PackageResolver};
 pub use self::params::{
-    glob_match, node_fqn, LoadedParams, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces, DEFAULT_NODE_FQN,
+    glob_match, node_fqn, InputFiles, LoadedParams, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces, DEFAULT_NODE_FQN,
 };
 pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, PositionsError, RobotModel};
 pub use self::srdf::{Srdf, SrdfError};

@@ -126,7 +126,7 @@ struct Outputs {
 
 /// Replays a bag. Reports before a corrupt tail are kept; the fault is in the summary and makes
 /// the result an error after the outputs are written.
-pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, opts: &ReplayOptions) -> Result<ReplaySummary> {
+pub fn replay(params: Params, opts: &ReplayOptions) -> Result<ReplaySummary> {
     let mut params = params;
     if let Some(p) = opts.pose_source {
         params.pose_source = p;
@@ -176,9 +176,9 @@ pub fn replay(params: Params, robot: Option<&Path>, environment: Option<&Path>, 
     // at its log time, as it would replace it in the running node.
     let mut pipeline = if bag.topics().iter().any(|(t, _)| t == DESCRIPTION_TOPIC) {
         // An SRDF given for the recorded robot is checked against it when it comes.
-        Pipeline::new_expecting_description(params, robot, environment)?
+        Pipeline::new_expecting_description(params)?
     } else {
-        Pipeline::new(params, robot, environment)?
+        Pipeline::new(params)?
     };
 
     let mut out = Outputs {
