@@ -9,6 +9,7 @@ pub mod mesh_file;
 mod package;
 mod params;
 mod robot;
+mod robot_parse;
 mod srdf;
 mod xacro;
 pub mod xml_guard;

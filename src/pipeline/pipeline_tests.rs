@@ -60,7 +60,7 @@ fn partial_states_from_two_publishers_merge_under_last() {
     // From then on every partial message gives a state: the rest comes from the merge.
     let (_, clear) = poses();
     let c = p.joint_state(&js(&ARM[..6], &clear[..6], 3)).unwrap();
-    let mut both = clear.clone();
+    let mut both = clear;
     both[6..].copy_from_slice(&hit[6..]);
     assert_eq!(c, pipeline(Params::default()).joint_state(&js(&ARM, &both, 3)).unwrap());
     assert_eq!(p.skipped().get(&SkipCause::Incomplete), Some(&1));
