@@ -102,7 +102,7 @@ impl RobotModel {
         let visual_only_links = if use_visual { 0 } else { urdf.links.iter().filter(|l| l.collision.is_empty() && !l.visual.is_empty()).count() };
         let reader = UrdfReader { file, base_dir, resolver, use_visual };
         let (links, link_index) = reader.links(&urdf.links)?;
-        let (mut joints, joint_index, parent_of) = reader.joints(&urdf.joints, &link_index, links.len())?;
+        let ReadJoints { mut joints, joint_index, parent_of } = reader.joints(&urdf.joints, &link_index, links.len())?;
         reader.mimics(&urdf.joints, &joint_index, &mut joints)?;
         let root = root_link(&links, &parent_of).map_err(structure)?;
         let order = joint_order(root, &links, &joints).map_err(structure)?;
@@ -130,6 +130,14 @@ fn parse_urdf(text: &str, file: &str) -> Result<urdf_rs::Robot, ModelError> {
     contain_panic(|| urdf_rs::read_from_string(text))
         .map_err(|panic| malformed(format!("urdf-rs failed on this text ({panic})")))?
         .map_err(|e| malformed(crate::limits::first_line(&e.to_string())))
+}
+
+/// The joints of a URDF as read (mimics not yet resolved), their indices by name, and per link
+/// the joint whose child it is.
+struct ReadJoints {
+    joints: Vec<JointModel>,
+    joint_index: HashMap<String, usize>,
+    parent_of: Vec<Option<usize>>,
 }
 
 /// What the links and joints of one URDF are read with.
@@ -212,15 +220,8 @@ impl UrdfReader<'_> {
         Ok(LinkGeometry { origin: isometry(origin), spec })
     }
 
-    /// The joints (mimics not yet resolved), their indices by name, and per link the joint whose
-    /// child it is.
-    #[allow(clippy::type_complexity)]
-    fn joints(
-        &self,
-        urdf: &[urdf_rs::Joint],
-        link_index: &HashMap<String, usize>,
-        link_count: usize,
-    ) -> Result<(Vec<JointModel>, HashMap<String, usize>, Vec<Option<usize>>), ModelError> {
+    /// The joints, each between two links of `link_index`, a link the child of one joint at most.
+    fn joints(&self, urdf: &[urdf_rs::Joint], link_index: &HashMap<String, usize>, link_count: usize) -> Result<ReadJoints, ModelError> {
         let mut joint_index = HashMap::new();
         let mut joints = Vec::with_capacity(urdf.len());
         let mut parent_of = vec![None; link_count];
@@ -237,7 +238,7 @@ impl UrdfReader<'_> {
             }
             joints.push(self.joint(j, parent, child)?);
         }
-        Ok((joints, joint_index, parent_of))
+        Ok(ReadJoints { joints, joint_index, parent_of })
     }
 
     /// One joint between links `parent` and `child`, its axis, origin and limits checked.
