@@ -16,7 +16,7 @@ use thickness_collision::replay::{replay, Quiet, ReplayOptions};
 const STATES: usize = 100_000;
 
 fn main() {
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let mut rng = Rand64::new(42);
     let states: Vec<(Vec<String>, Vec<f64>)> = (0..STATES)
         .map(|_| {
@@ -57,7 +57,7 @@ fn main() {
             no_markers: true,
         };
         let started = Instant::now();
-        let summary = replay(Params::default(), None, None, &opts, &mut Quiet).unwrap();
+        let summary = replay(Params::default(), &opts, &mut Quiet).unwrap();
         let secs = started.elapsed().as_secs_f64();
         assert_eq!(summary.states, STATES);
         println!("{label:<44} {secs:>10.3} {:>12.0} {:>12.2}", STATES as f64 / secs, secs / STATES as f64 * 1e6);

@@ -70,7 +70,7 @@ fn median(v: &mut [f64]) -> f64 {
 fn main() {
     let rounds: usize = std::env::var("ROUNDS").ok().and_then(|v| v.parse().ok()).unwrap_or(3);
     let bags = std::env::var("BAGS").unwrap_or_default();
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let root = std::env::temp_dir().join(format!("tc_bench_replay_view_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&root);
     if bags != "sweep" {
@@ -119,7 +119,7 @@ fn scenario(root: &Path, checker: &Checker, sweep: bool, rounds: usize) {
                 ..Default::default()
             };
             let (started, cpu0) = (Instant::now(), cpu_seconds());
-            let summary = replay(Params::default(), None, None, &opts, &mut thickness_collision::replay::Quiet).unwrap();
+            let summary = replay(Params::default(), &opts, &mut thickness_collision::replay::Quiet).unwrap();
             let secs = started.elapsed().as_secs_f64();
             cpu[c].push(cpu_seconds() - cpu0);
             assert_eq!(summary.states, STATES);

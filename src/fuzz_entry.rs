@@ -158,7 +158,7 @@ fn scratch_dir() -> &'static Path {
 /// them from it); its `check` keeps no state.
 fn workcell() -> &'static Pipeline {
     static WORKCELL: OnceLock<Pipeline> = OnceLock::new();
-    WORKCELL.get_or_init(|| match Pipeline::new(Params::default(), None, None) {
+    WORKCELL.get_or_init(|| match Pipeline::new(Params::default()) {
         Ok(mut p) => {
             let name: Vec<String> = p.checker().robot().joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
             let position = vec![0.0; name.len()];
@@ -182,7 +182,7 @@ fn line_pipeline() -> &'static Mutex<(Pipeline, usize, Option<RobotState>)> {
 const LINES_PER_PIPELINE: usize = 2_000;
 
 fn fresh_workcell() -> Pipeline {
-    match Pipeline::new(Params::default(), None, None) {
+    match Pipeline::new(Params::default()) {
         Ok(p) => p,
         Err(e) => panic!("fuzz_entry: the bundled workcell does not load: {e}"),
     }
@@ -199,7 +199,7 @@ fn fresh_pipeline() -> Pipeline {
         }
         path
     });
-    match Pipeline::new(Params::default(), None, Some(env)) {
+    match Pipeline::new(Params { input_files: crate::model::InputFiles { robot: None, environment: Some(env.clone()) }, ..Params::default() }) {
         Ok(p) => p,
         Err(e) => panic!("fuzz_entry: the bundled robot does not load: {e}"),
     }

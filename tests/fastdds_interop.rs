@@ -261,7 +261,7 @@ fn fastdds_tf_input_equals_check_with_transforms() {
     let mut peer = FastDdsPeer::start(&PeerOptions::loopback(domain));
 
     // Link poses from forward kinematics, sent as world -> <link> transforms on /tf.
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let (mut tf_states, mut lines) = (Vec::new(), Vec::new());
     for k in 0..12 {
         let mut q = vec![0.0; checker.robot().joints.len()];

@@ -74,7 +74,7 @@ fn seeds_reach_checked_states() {
     use thickness_collision::replay::decode_cdr;
     let seeds = seeds();
     let seed = |target: &str, name: &str| seeds.iter().find(|(t, n, _)| *t == target && n == name).map(|s| s.2.clone()).expect("a seed");
-    let mut pipeline = Pipeline::new(Params::default(), None, None).expect("the bundled workcell");
+    let mut pipeline = Pipeline::new(Params::default()).expect("the bundled workcell");
 
     let input = seed("cdr", "joint_state.cdr");
     let records = split_records(&input);

@@ -22,11 +22,11 @@ fn issue_11_from_models_validates_the_parameters() {
     let mut params = Params::default();
     params.thin_surfaces.patterns = vec!["guard_*".into(), "shelf".into()];
     params.thin_surfaces.thickness = vec![0.03];
-    let e = Checker::from_models(params, arm(), workcell(), "arm".into(), "cell".into()).err().expect("refused");
+    let e = Checker::from_models(params, arm(), workcell(), "arm".into(), "cell".into(), None).err().expect("refused");
     assert!(matches!(e, CheckerError::Params(_)), "{e}");
     assert!(e.to_string().contains("thin_surfaces.thickness"), "{e}");
     let params = Params { padding: thickness_collision::model::Padding { links: vec!["*".into()], values: vec![] }, ..Params::default() };
-    let e = Checker::from_models(params, arm(), workcell(), "arm".into(), "cell".into()).err().expect("refused");
+    let e = Checker::from_models(params, arm(), workcell(), "arm".into(), "cell".into(), None).err().expect("refused");
     assert!(e.to_string().contains("padding.values"), "{e}");
 }
 
@@ -40,7 +40,7 @@ fn issue_11_forward_kinematics_checks_its_positions() {
     let e = robot.forward_kinematics(&q, &base).unwrap_err();
     assert!(e.to_string().contains(&robot.joints[2].name) && e.to_string().contains("inf"), "{e}");
     // Through the checker as well.
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     assert!(checker.check_positions(&[0.0; 3]).unwrap_err().to_string().contains("3 joint positions"));
     assert!(checker.check_world_poses(&[None; 2]).is_err());
 }

@@ -13,7 +13,7 @@ use thickness_collision::model::{bundled_config_dir, JointKind, PackageResolver,
 fn load(rel: &str) -> (Checker, std::path::PathBuf, Vec<String>) {
     let (urdf, map) = common::erd_robot(rel);
     let params = Params { package_map: map.clone(), robot_description_file: urdf.display().to_string(), ..Params::default() };
-    let checker = Checker::from_params(params, None, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
+    let checker = Checker::from_params(params).unwrap_or_else(|e| panic!("{rel}: {e}"));
     (checker, urdf, map)
 }
 

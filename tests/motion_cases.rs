@@ -40,7 +40,7 @@ fn along(robot: &RobotModel, q0: &[f64], q1: &[f64], s: f64) -> Vec<f64> {
 /// prismatic finger with its mimic), against samples 0.5 mm apart at the fastest point.
 #[test]
 fn the_bundled_arm_with_continuous_prismatic_and_mimic_joints_agrees_with_dense_sampling() {
-    let c = Checker::from_params(Params::default(), None, None).unwrap();
+    let c = Checker::from_params(Params::default()).unwrap();
     let robot = c.robot();
     let mut rng = Rand64::new(7);
     let (mut caught, mut free, mut through_sheet) = (0, 0, 0);

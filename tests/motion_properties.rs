@@ -20,7 +20,7 @@ use parry3d_f64::shape::ConvexPolyhedron;
 use thickness_collision::checker::{Checker, ObjectType};
 use thickness_collision::collision::{ObjectBody, TargetShape};
 use thickness_collision::math::pose_from_isometry;
-use thickness_collision::model::Params;
+use thickness_collision::model::{InputFiles, Params};
 
 const REACH: f64 = 1.2;
 const STEP: f64 = 1e-3;
@@ -32,9 +32,10 @@ fn panda() -> Checker {
         package_map: vec![format!("example-robot-data={}", erd.display())],
         // Raised 5 mm off the table it stands on (a link resting on the table collides with it).
         robot_base_pose: vec![0.0, 0.0, 0.005, 0.0, 0.0, 0.0],
+        input_files: InputFiles { robot: Some(erd.join("robots/panda_description/urdf/panda.urdf")), environment: None },
         ..Params::default()
     };
-    Checker::from_params(params, Some(&erd.join("robots/panda_description/urdf/panda.urdf")), None).unwrap()
+    Checker::from_params(params).unwrap()
 }
 
 #[test]

@@ -82,7 +82,7 @@ fn joint_sequence() -> Vec<Value> {
 }
 
 fn tf_of(k: usize, prefix: &str, parent: &str, q: &[f64]) -> Value {
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let mut full = vec![0.0; checker.robot().joints.len()];
     for (n, v) in ARM.iter().zip(q) {
         full[checker.robot().joint(n).unwrap()] = *v;

@@ -29,7 +29,7 @@ fn ok(out: Output) -> String {
 
 /// Random states of the bundled arm, a good share of them colliding with the workcell.
 fn states(n: usize, seed: u64) -> Vec<(Vec<String>, Vec<f64>)> {
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let mut rng = Rand64::new(seed as u128);
     (0..n)
         .map(|_| {
@@ -159,7 +159,7 @@ fn joint_state_bags_replay_like_check_and_read_back() {
 #[test]
 fn tf_bags_replay_like_check_with_transforms() {
     let st = states(120, 11);
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let d = dir("tf");
     let mut msgs = Vec::new();
     let mut lines = Vec::new();

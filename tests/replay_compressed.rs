@@ -30,7 +30,7 @@ const T0: i64 = 1_700_000_000_000_000_000;
 
 /// Random states of the bundled arm as bag_tool.py messages, 10 ms apart.
 fn joint_messages(n: usize, seed: u64) -> Vec<Value> {
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let mut rng = Rand64::new(seed as u128);
     (0..n)
         .map(|k| {

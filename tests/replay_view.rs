@@ -190,7 +190,7 @@ fn replay_writes_markers_tf_description_and_a_timeline() {
     assert_eq!(view["robot_description"], json!([urdf]));
 
     // /tf: per state, world to every link, at the poses check's forward kinematics gives.
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let robot = checker.robot();
     let joint_index: Vec<usize> = JOINTS.iter().map(|j| robot.joint(j).unwrap()).collect();
     let tf = view["tf"].as_array().unwrap();

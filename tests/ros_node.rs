@@ -184,7 +184,7 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     assert!(banner.contains("/robot1/thickness_collision") && banner.contains("/tf"), "{banner}");
 
     // Link poses from forward kinematics, sent as world -> robot1/<link> transforms.
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let mut tf_states = Vec::new();
     let mut lines = Vec::new();
     for k in 0..12 {

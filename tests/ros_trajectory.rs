@@ -33,7 +33,7 @@ struct Arm {
 
 impl Arm {
     fn new() -> Arm {
-        let checker = Checker::from_params(Params::default(), None, None).unwrap();
+        let checker = Checker::from_params(Params::default()).unwrap();
         let actuated: Vec<(usize, String)> =
             checker.robot().joints.iter().enumerate().filter(|(_, j)| j.is_actuated()).map(|(i, j)| (i, j.name.clone())).collect();
         Arm { names: actuated.iter().map(|a| a.1.clone()).collect(), index: actuated.iter().map(|a| a.0).collect(), checker }

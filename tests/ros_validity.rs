@@ -46,7 +46,7 @@ fn check_state_validity_agrees_with_check_and_refuses_what_it_cannot_honour() {
     let cyclone = common::cyclone_loopback_file(&dir);
 
     // Random states of the bundled arm within its limits, some free and some not.
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let joints: Vec<_> = checker.robot().joints.iter().filter(|j| j.is_actuated()).collect();
     let names: Vec<String> = joints.iter().map(|j| j.name.clone()).collect();
     let mut rng = Rand64::new(13);

@@ -1,7 +1,7 @@
 //! Clearance per link: how near each checked link is to the environment, when the
 //! `clearance_threshold` parameter asks for it.
 
-use super::checker_build::LinkTargets;
+use super::link_targets::LinkTargets;
 use super::state_report::ReportClearance;
 use crate::collision::{Contact, Scene, Target};
 use crate::math::{Pose, Real, Vector};

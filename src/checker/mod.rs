@@ -3,18 +3,30 @@
 //! thickness cells and solids, and robot states (joint positions or link poses) turned into
 //! collision reports.
 
+#[allow(clippy::module_inception)]
+mod checker;
 mod checker_build;
+mod checker_error;
 mod clearance;
+mod geometry_shapes;
+mod joint_motion;
 mod joint_state;
-mod motion;
+mod link_targets;
+mod motion_bounds;
+mod motion_contact;
 mod motion_sweep;
 mod self_collision;
-pub use self::self_collision::SelfPairs;
+mod self_pairs;
+mod state_check;
 mod state_report;
 mod world_motion;
 
-pub use self::checker_build::{BuildSummary, Checker, CheckerError, LinkTargets};
+pub use self::checker::{BuildSummary, Checker};
+pub(crate) use self::checker_build::read_semantic_file;
+pub use self::checker_error::CheckerError;
 pub(crate) use self::joint_state::not_our_robot;
 pub use self::joint_state::StateError;
-pub use self::motion::{MotionReport, MAX_SUBINTERVALS};
+pub use self::link_targets::LinkTargets;
+pub use self::motion_sweep::{MotionReport, MAX_SUBINTERVALS};
+pub use self::self_pairs::SelfPairs;
 pub use self::state_report::{ObjectType, ReportClearance, ReportContact, StateReport};

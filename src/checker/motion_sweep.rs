@@ -1,14 +1,18 @@
-//! The adaptive loop that joint-space motions and link-pose motions share: given a bound on how
-//! fast every point of each checked link moves along the motion parameter `s`, the link poses at
-//! any `s`, and the report of the state at any `s`, find the first stretch of the motion that
-//! cannot be cleared.
+//! The one adaptive loop every motion check runs (joint-space motions in `joint_motion`, link-pose
+//! motions in `world_motion`): given a bound on how fast every point of each checked link moves
+//! along the motion parameter `s`, the link poses at any `s`, and the report of the state at any
+//! `s`, find the first stretch of the motion that cannot be cleared, for the links against the
+//! environment and for the self pairs alike.
 
-use super::checker_build::Checker;
-use super::motion::{grow, MotionBounds, MotionReport, MAX_SUBINTERVALS};
-use super::state_report::{ObjectType, ReportContact, StateReport};
-use crate::collision::{collide_pair, pair_may_meet, CollideSettings, PairContact, Target, TargetShape};
+use super::checker::Checker;
+use super::motion_bounds::MotionBounds;
+use super::state_report::StateReport;
+use crate::collision::CollideSettings;
 use crate::math::{Pose, Real};
 use std::collections::hash_map::{Entry, HashMap};
+
+/// Sub-intervals examined at most per motion; past that the motion fails closed.
+pub const MAX_SUBINTERVALS: u64 = 1 << 20;
 
 /// Growth above which a sub-interval is split without being tested (metres): it only saves work.
 /// On the motion benchmark (Panda, 1M cells, 2,000 motions) links grown by more than 0.36 m were
@@ -16,6 +20,23 @@ use std::collections::hash_map::{Entry, HashMap};
 /// testing above 0.15 m took the mean time per motion from 15.4 to 11.3 state checks (14 % more
 /// link tests, each cheaper).
 const MAX_TESTED_GROWTH: Real = 0.15;
+
+/// Link poses kept for reuse at most (cleared past this): a motion that needs millions of
+/// midpoints must not keep a pose set for each.
+const MAX_CACHED_POSES: usize = 4096;
+
+/// What a motion check gives.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MotionReport {
+    /// `in_collision`, `contacts` (of the pose at `fraction`) and `error`, as for a state.
+    pub report: StateReport,
+    /// The start of the first sub-interval that could not be cleared, in [0, 1]; `None` when free
+    /// or not checked.
+    pub fraction: Option<f64>,
+    /// Sub-intervals examined, counted once for each link tested on one (the count
+    /// `MAX_SUBINTERVALS` bounds).
+    pub subintervals: u64,
+}
 
 /// A motion as the adaptive loop sees it.
 pub(super) trait MotionPath {
@@ -44,19 +65,29 @@ pub(super) trait MotionPath {
     }
 }
 
-/// Link poses kept for reuse at most (cleared past this): a motion that needs millions of
-/// midpoints must not keep a pose set for each.
-const MAX_CACHED_POSES: usize = 4096;
+/// What one run of the loop clears: a target against the environment, or a self pair.
+#[derive(Clone, Copy)]
+enum Swept {
+    Target(usize),
+    Pair(usize, usize),
+}
 
-/// Where a motion could not be cleared: the start of the stretch, the target, the ladder level it
-/// was grown by and its pose at the stretch's middle.
+/// A target grown for one stretch: its ladder level (`None`: as it is), whether that growth is
+/// worth testing, and its link's pose at the stretch's middle.
+#[derive(Clone, Copy)]
+pub(super) struct Grown {
+    pub(super) ti: usize,
+    pub(super) level: Option<usize>,
+    tested: bool,
+    pub(super) pose: Pose,
+}
+
+/// Where a motion could not be cleared: the start of the stretch and the target grown there
+/// (for a self pair, both).
 struct Blocked {
     fraction: f64,
-    ti: usize,
-    level: Option<usize>,
-    pose: Pose,
-    /// For a self pair: the other target, its level and its pose.
-    other: Option<(usize, Option<usize>, Pose)>,
+    grown: Grown,
+    other: Option<Grown>,
 }
 
 /// What the test of one stretch found.
@@ -69,16 +100,33 @@ enum Stretch {
     Blocked(Blocked),
 }
 
-/// The ladder level that covers a displacement bound, and whether it is worth testing with: the
-/// growth covers the bound (rounding, NaN or past the ladder's top: split) and is not beyond what
-/// is worth testing (the first rung always is). A target that does not move is tested as it is.
-fn rung(bounds: &MotionBounds, delta: Real) -> (Option<usize>, bool) {
+impl Stretch {
+    /// The verdict on the stretch from `start` where `grown` (and `other`, for a pair) were
+    /// grown: clear when every growth is worth testing and `meets` finds nothing; blocked when
+    /// no growth can shrink further (the first rung, or a target that does not move); else split.
+    fn judge(start: f64, grown: Grown, other: Option<Grown>, meets: impl FnOnce() -> bool) -> Stretch {
+        let all = |f: fn(&Grown) -> bool| f(&grown) && other.as_ref().is_none_or(f);
+        if all(|g| g.tested) && !meets() {
+            Stretch::Clear
+        } else if all(|g| g.level.is_none_or(|l| l == 0)) {
+            Stretch::Blocked(Blocked { fraction: start, grown, other })
+        } else {
+            Stretch::Split
+        }
+    }
+}
+
+/// Target `ti` at `pose` grown to cover a displacement bound `delta`: the ladder level that
+/// covers it, worth testing when the growth covers the bound (rounding, NaN or past the ladder's
+/// top: split) and is not beyond what is worth testing (the first rung always is). A target
+/// that does not move is tested as it is.
+fn grown_for(bounds: &MotionBounds, ti: usize, pose: Pose, delta: Real) -> Grown {
     if delta > 0.0 {
         let level = bounds.level(delta);
         let growth = bounds.growth(level);
-        (Some(level), growth >= delta && (growth <= MAX_TESTED_GROWTH || level == 0))
+        Grown { ti, level: Some(level), tested: growth >= delta && (growth <= MAX_TESTED_GROWTH || level == 0), pose }
     } else {
-        (None, true)
+        Grown { ti, level: None, tested: true, pose }
     }
 }
 
@@ -132,65 +180,21 @@ impl Sweep {
 }
 
 impl Checker {
-    /// The adaptive loop over `path` (see the module documentation of `motion`). Targets, then
-    /// self pairs, are cleared one after the other, each over `[0, limit)`, where `limit` is the
-    /// earliest stretch that an earlier one could not clear: the answer is the earliest over all,
-    /// as if they were examined together, left half first.
+    /// The adaptive loop over `path` (see the module documentation of `joint_motion`). Targets,
+    /// then self pairs, are cleared one after the other, each over `[0, limit)`, where `limit` is
+    /// the earliest stretch that an earlier one could not clear: the answer is the earliest over
+    /// all, as if they were examined together, left half first.
     pub(super) fn sweep_motion(&self, path: &impl MotionPath) -> MotionReport {
-        let bounds = self.motion_bounds();
-        let speed = path.speeds();
-        let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
+        let targets = (0..self.targets().len()).map(Swept::Target);
+        let pairs = self.self_pairs().pairs.iter().map(|&(a, b)| Swept::Pair(a, b));
         let mut sweep = Sweep { poses_at: HashMap::new(), blocked: None, examined: 0, stack: Vec::with_capacity(64) };
-        let mut run = || -> Result<(), String> {
-            for (ti, lt) in self.targets().iter().enumerate() {
-                sweep.clear(path, |poses, a, half| {
-                    let pose = poses[lt.link].ok_or_else(|| format!("no pose for link '{}'", lt.name))?;
-                    // A link that does not move is where it is at every s: checked as it is,
-                    // ungrown (a base resting on a table is not a near miss).
-                    let (level, tested) = if speed[ti] > 0.0 { rung(bounds, path.bound(ti, poses, half)) } else { (None, true) };
-                    Ok(if tested && !self.grown_link_hit(ti, level, &pose, &flags) {
-                        Stretch::Clear
-                    } else if level.is_none_or(|l| l == 0) {
-                        Stretch::Blocked(Blocked { fraction: a, ti, level, pose, other: None })
-                    } else {
-                        Stretch::Split
-                    })
-                })?;
-            }
-            // A pair is cleared on a stretch when its two links at the middle, each grown by its
-            // own displacement bound, do not meet (then they stay apart all along the stretch).
-            for &(ta, tb) in &self.self_pairs().pairs {
-                let (la, lb) = (&self.targets()[ta], &self.targets()[tb]);
-                sweep.clear(path, |poses, a, half| {
-                    let (Some(pa), Some(pb)) = (poses[la.link], poses[lb.link]) else {
-                        return Err(format!("no pose for link '{}' or '{}'", la.name, lb.name));
-                    };
-                    // Balls that hold the two links, each grown by its bound, apart: the pair
-                    // stays apart all along the stretch, at any growth (no hull test needed).
-                    // Most pairs are cleared so, on the quick bounds.
-                    let ((ca, ra), (cb, rb)) = (bounds.ball[ta], bounds.ball[tb]);
-                    let gap = (pa * ca - pb * cb).length() - ra - rb;
-                    let (quick_a, quick_b) = path.pair_bound_quick(ta, tb, poses, half);
-                    if gap > quick_a + quick_b {
-                        return Ok(Stretch::Clear);
-                    }
-                    let (delta_a, delta_b) = path.pair_bound(ta, tb, poses, half);
-                    if gap > delta_a + delta_b {
-                        return Ok(Stretch::Clear);
-                    }
-                    let ((level_a, tested_a), (level_b, tested_b)) = (rung(bounds, delta_a), rung(bounds, delta_b));
-                    Ok(if tested_a && tested_b && !self.grown_pair_may_meet(ta, level_a, &pa, tb, level_b, &pb) {
-                        Stretch::Clear
-                    } else if level_a.is_none_or(|l| l == 0) && level_b.is_none_or(|l| l == 0) {
-                        Stretch::Blocked(Blocked { fraction: a, ti: ta, level: level_a, pose: pa, other: Some((tb, level_b, pb)) })
-                    } else {
-                        Stretch::Split
-                    })
-                })?;
-            }
-            Ok(())
-        };
-        if let Err(error) = run() {
+        let run = targets.chain(pairs).try_for_each(|swept| {
+            sweep.clear(path, |poses, start, half| match swept {
+                Swept::Target(ti) => self.judge_target(path, ti, poses, start, half),
+                Swept::Pair(ta, tb) => self.judge_pair(path, ta, tb, poses, start, half),
+            })
+        });
+        if let Err(error) = run {
             let mut report = StateReport::failed(error);
             report.motion = true;
             return MotionReport { report, fraction: None, subintervals: sweep.examined };
@@ -202,119 +206,59 @@ impl Checker {
                 let clearances = if self.params().clearance_threshold > 0.0 { path.report_at(1.0).clearances } else { Vec::new() };
                 MotionReport { report: StateReport { motion: true, clearances, ..Default::default() }, fraction: None, subintervals: examined }
             }
-            Some(b) => match b.other {
-                None => self.motion_contact(path.report_at(b.fraction), b.ti, b.level, &b.pose, b.fraction, examined),
-                Some(other) => self.motion_self_contact(path.report_at(b.fraction), (b.ti, b.level, b.pose), other, b.fraction, examined),
-            },
-        }
-    }
-
-    /// Target `ti`'s part `pi` grown by ladder `level` (as it is for `None`).
-    fn grown_part(&self, ti: usize, pi: usize, level: Option<usize>) -> &TargetShape {
-        let (shape, _) = &self.targets()[ti].parts[pi];
-        match level {
-            None => shape,
-            Some(level) => {
-                let bounds = self.motion_bounds();
-                bounds.grown[ti][pi][level].get_or_init(|| grow(shape, bounds.growth(level)))
+            Some(b) => {
+                let report = path.report_at(b.fraction);
+                let report = match b.other {
+                    None => self.motion_contact(report, &b.grown),
+                    Some(other) => self.motion_self_contact(report, &b.grown, &other),
+                };
+                blocked_report(report, b.fraction, examined)
             }
         }
     }
 
-    /// Whether target `ti`, every part grown by ladder `level`, touches anything it may not.
-    fn grown_link_hit(&self, ti: usize, level: Option<usize>, link_pose: &Pose, settings: &CollideSettings) -> bool {
-        self.targets()[ti].parts.iter().enumerate().any(|(pi, (_, offset))| {
-            let target = Target::new(self.grown_part(ti, pi, level).clone(), *link_pose * *offset);
-            !self.collide_target(ti, &target, settings).contacts.is_empty()
-        })
+    /// A stretch of target `ti` against the environment.
+    fn judge_target(&self, path: &impl MotionPath, ti: usize, poses: &[Option<Pose>], start: f64, half: f64) -> Result<Stretch, String> {
+        let lt = &self.targets()[ti];
+        let pose = poses[lt.link].ok_or_else(|| format!("no pose for link '{}'", lt.name))?;
+        // A link that does not move is where it is at every s: checked as it is, ungrown (a
+        // base resting on a table is not a near miss).
+        let delta = if path.speeds()[ti] > 0.0 { path.bound(ti, poses, half) } else { 0.0 };
+        let grown = grown_for(self.motion_bounds(), ti, pose, delta);
+        let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
+        Ok(Stretch::judge(start, grown, None, || self.grown_link_hit(&grown, &flags)))
     }
 
-    /// Whether any part of target `ta` may meet any of `tb`, each grown by its ladder level, at
-    /// the given link poses (see [`pair_may_meet`]).
-    fn grown_pair_may_meet(&self, ta: usize, level_a: Option<usize>, pa: &Pose, tb: usize, level_b: Option<usize>, pb: &Pose) -> bool {
-        self.targets()[ta].parts.iter().enumerate().any(|(ia, (_, oa))| {
-            let part_a = Target::new(self.grown_part(ta, ia, level_a).clone(), *pa * *oa);
-            self.targets()[tb]
-                .parts
-                .iter()
-                .enumerate()
-                .any(|(ib, (_, ob))| pair_may_meet(&part_a, &Target::new(self.grown_part(tb, ib, level_b).clone(), *pb * *ob)))
-        })
-    }
-
-    /// The deepest contact between the parts of targets `ta` and `tb`, each grown by its ladder
-    /// level, at the given link poses.
-    pub(super) fn grown_pair_contact(&self, ta: usize, level_a: Option<usize>, pa: &Pose, tb: usize, level_b: Option<usize>, pb: &Pose) -> Option<PairContact> {
-        let mut best: Option<PairContact> = None;
-        for (ia, (_, oa)) in self.targets()[ta].parts.iter().enumerate() {
-            let part_a = Target::new(self.grown_part(ta, ia, level_a).clone(), *pa * *oa);
-            for (ib, (_, ob)) in self.targets()[tb].parts.iter().enumerate() {
-                let part_b = Target::new(self.grown_part(tb, ib, level_b).clone(), *pb * *ob);
-                if let Some(c) = collide_pair(&part_a, &part_b) {
-                    if best.is_none_or(|x| c.depth > x.depth) {
-                        best = Some(c);
-                    }
-                }
-            }
+    /// A stretch of self pair `(ta, tb)`: cleared when its two links at the middle, each grown by
+    /// its own displacement bound, do not meet (then they stay apart all along the stretch).
+    fn judge_pair(&self, path: &impl MotionPath, ta: usize, tb: usize, poses: &[Option<Pose>], start: f64, half: f64) -> Result<Stretch, String> {
+        let (la, lb) = (&self.targets()[ta], &self.targets()[tb]);
+        let (Some(pa), Some(pb)) = (poses[la.link], poses[lb.link]) else {
+            return Err(format!("no pose for link '{}' or '{}'", la.name, lb.name));
+        };
+        // Balls that hold the two links, each grown by its bound, apart: the pair stays apart
+        // all along the stretch, at any growth (no hull test needed). Most pairs are cleared so,
+        // on the quick bounds.
+        let bounds = self.motion_bounds();
+        let ((ca, ra), (cb, rb)) = (bounds.ball[ta], bounds.ball[tb]);
+        let gap = (pa * ca - pb * cb).length() - ra - rb;
+        let (quick_a, quick_b) = path.pair_bound_quick(ta, tb, poses, half);
+        if gap > quick_a + quick_b {
+            return Ok(Stretch::Clear);
         }
-        best
-    }
-
-    /// As [`Checker::motion_contact`] for a self pair: for a near miss, the pair the grown links
-    /// met as, depth 0.
-    fn motion_self_contact(
-        &self,
-        mut report: StateReport,
-        a: (usize, Option<usize>, Pose),
-        b: (usize, Option<usize>, Pose),
-        fraction: f64,
-        examined: u64,
-    ) -> MotionReport {
-        let (name_a, name_b) = (&self.targets()[a.0].name, &self.targets()[b.0].name);
-        if !report.contacts.iter().any(|c| &c.link_name == name_a && &c.object_name == name_b) {
-            if let Some(c) = self.grown_pair_contact(a.0, a.1, &a.2, b.0, b.1, &b.2) {
-                report.contacts.push(ReportContact {
-                    link_name: name_a.clone(),
-                    object_name: name_b.clone(),
-                    triangle: u32::MAX,
-                    depth: 0.0,
-                    position: Some(c.position.to_array()),
-                    normal: c.normal.to_array(),
-                    object_type: ObjectType::RobotLink,
-                });
-            }
+        let (delta_a, delta_b) = path.pair_bound(ta, tb, poses, half);
+        if gap > delta_a + delta_b {
+            return Ok(Stretch::Clear);
         }
-        report.in_collision = true;
-        report.motion = true;
-        report.fraction = Some(fraction);
-        MotionReport { report, fraction: Some(fraction), subintervals: examined }
+        let (a, b) = (grown_for(bounds, ta, pa, delta_a), grown_for(bounds, tb, pb, delta_b));
+        Ok(Stretch::judge(start, a, Some(b), || self.grown_pair_may_meet(&a, &b)))
     }
+}
 
-    /// The report of a motion found colliding on the stretch starting at `fraction`: `report` is
-    /// that of the pose there; for a near miss (the link does not collide there) the object the
-    /// grown link at `link_pose` touched is added, with depth 0.
-    fn motion_contact(&self, mut report: StateReport, ti: usize, level: Option<usize>, link_pose: &Pose, fraction: f64, examined: u64) -> MotionReport {
-        if !report.contacts.iter().any(|c| c.link_name == self.targets()[ti].name) {
-            let settings = CollideSettings { flag_only: false, least_overlap: false, ..Default::default() };
-            let lt = &self.targets()[ti];
-            let near = lt.parts.iter().enumerate().find_map(|(pi, (_, offset))| {
-                self.collide_target(ti, &Target::new(self.grown_part(ti, pi, level).clone(), *link_pose * *offset), &settings).deepest().copied()
-            });
-            if let Some(c) = near {
-                report.contacts.push(ReportContact {
-                    link_name: lt.name.clone(),
-                    object_name: self.scene().objects()[c.object].name.clone(),
-                    triangle: c.triangle,
-                    depth: 0.0,
-                    position: c.position.map(|p| p.to_array()),
-                    normal: c.normal.to_array(),
-                    object_type: ObjectType::Environment,
-                });
-            }
-        }
-        report.in_collision = true;
-        report.motion = true;
-        report.fraction = Some(fraction);
-        MotionReport { report, fraction: Some(fraction), subintervals: examined }
-    }
+/// The report of a motion found colliding on the stretch starting at `fraction`.
+fn blocked_report(mut report: StateReport, fraction: f64, examined: u64) -> MotionReport {
+    report.in_collision = true;
+    report.motion = true;
+    report.fraction = Some(fraction);
+    MotionReport { report, fraction: Some(fraction), subintervals: examined }
 }

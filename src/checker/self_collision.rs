@@ -7,24 +7,14 @@
 //! `panda_link8`, are adjacent) and pairs that touch at the zero state (within `motion_tolerance`). `allowed_collisions`
 //! entries naming two robot links allow that pair either way round.
 
-use super::checker_build::{Checker, LinkTargets};
+use super::checker::Checker;
+use super::link_targets::LinkTargets;
+use super::self_pairs::SelfPairs;
 use super::state_report::{ObjectType, ReportContact};
 use crate::collision::{collide_pair, PairContact, Target};
 use crate::math::Pose;
 use crate::model::{RobotModel, Srdf};
 use std::collections::BTreeSet;
-
-/// The pairs checked, and why the others are not.
-#[derive(Clone, Debug, Default)]
-pub struct SelfPairs {
-    /// Target indices `(a, b)`, `a < b` (model order), checked against each other.
-    pub pairs: Vec<(usize, usize)>,
-    /// The SRDF the matrix comes from, if any.
-    pub srdf: Option<Srdf>,
-    /// Without an SRDF: the non-adjacent pairs allowed because they touch at the zero state, as
-    /// link names (printed once).
-    pub allowed_at_zero: Vec<(String, String)>,
-}
 
 /// Target pairs joined through links without a target (transparent), as target indices.
 fn adjacent_pairs(robot: &RobotModel, targets: &[LinkTargets]) -> BTreeSet<(usize, usize)> {

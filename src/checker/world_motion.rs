@@ -10,10 +10,9 @@
 //! interpolated as `q0·exp(s·log(q0⁻¹q1))` exactly, not by a normalised lerp (whose angular speed
 //! exceeds `θ_k` in the middle).
 
-use super::checker_build::Checker;
+use super::checker::Checker;
 use super::joint_state::StateError;
-use super::motion::MotionReport;
-use super::motion_sweep::MotionPath;
+use super::motion_sweep::{MotionPath, MotionReport};
 use super::state_report::StateReport;
 use crate::math::{Pose, Real, Rotation, Vector};
 

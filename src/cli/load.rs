@@ -3,7 +3,7 @@
 use crate::ModelArgs;
 use anyhow::{bail, Result};
 use std::path::PathBuf;
-use thickness_collision::model::{Params, DEFAULT_NODE_FQN};
+use thickness_collision::model::{InputFiles, Params, DEFAULT_NODE_FQN};
 use thickness_collision::pipeline::Pipeline;
 
 /// The parameters file (or the defaults) with the command line's overrides applied, read for
@@ -36,6 +36,7 @@ pub fn params_for_node(args: &ModelArgs, more: &[PathBuf], node_fqn: &str) -> Re
     if let Some(srdf) = &args.srdf {
         params.robot_semantic_file = srdf.display().to_string();
     }
+    params.input_files = InputFiles { robot: args.robot.clone(), environment: args.environment.clone() };
     if let Some(side) = args.side {
         params.default_side = side;
         let n = params.thin_surfaces.patterns.len();
@@ -47,5 +48,5 @@ pub fn params_for_node(args: &ModelArgs, more: &[PathBuf], node_fqn: &str) -> Re
 
 /// Loads the robot and the environment into the pipeline every front door feeds.
 pub fn pipeline(args: &ModelArgs) -> Result<Pipeline> {
-    Ok(Pipeline::new(params(args)?, args.robot.as_deref(), args.environment.as_deref())?)
+    Ok(Pipeline::new(params(args)?)?)
 }

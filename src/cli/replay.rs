@@ -10,7 +10,7 @@ pub fn replay(args: &ModelArgs, opts: &ReplayOptions) -> Result<()> {
     check_window(opts)?;
     let params = super::load::params(args)?;
     let mut printer = Printer::new();
-    let summary = run_replay(params, args.robot.as_deref(), args.environment.as_deref(), opts, &mut printer)?;
+    let summary = run_replay(params, opts, &mut printer)?;
     println!("{summary}");
     if let Some(e) = &summary.bag_error {
         // The reports before the fault are written; the bag itself is bad.

@@ -13,5 +13,5 @@ pub fn run(args: &ModelArgs, ros_args: &[String]) -> Result<()> {
     let fqn = node_fqn(ros_args.namespace.as_deref(), ros_args.node_name.as_deref());
     let more: Vec<PathBuf> = ros_args.params_files.iter().map(PathBuf::from).collect();
     let params: Params = super::load::params_for_node(args, &more, &fqn)?;
-    run_node(params, &RunOptions { ros_args, robot: args.robot.clone(), environment: args.environment.clone() })
+    run_node(params, &RunOptions { ros_args })
 }

@@ -33,6 +33,16 @@ pub fn bundled_config_dir() -> PathBuf {
     resolve(prefix.as_deref(), &source, cache_root().as_deref())
 }
 
+/// The bundled example arm's URDF: the robot when no file names one.
+pub(crate) fn bundled_robot() -> PathBuf {
+    bundled_config_dir().join("example_workcell/robot.urdf")
+}
+
+/// The bundled example workcell's URDF: the environment when no file names one.
+pub(crate) fn bundled_environment() -> PathBuf {
+    bundled_config_dir().join("example_workcell/environment.urdf")
+}
+
 /// The first of `prefix` and `source` that holds the workcell, else the compiled-in copy under
 /// `cache` (written if missing or different).
 pub(crate) fn resolve(prefix: Option<&Path>, source: &Path, cache: Option<&Path>) -> PathBuf {

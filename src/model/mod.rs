@@ -10,13 +10,14 @@ mod package;
 mod params;
 mod params_file;
 mod robot;
+mod robot_parse;
 mod srdf;
 mod xacro;
 pub mod xml_guard;
 
 pub use self::bundled::bundled_config_dir;
 pub use self::package::{PackageError, PackageResolver};
-pub use self::params::{glob_match, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};
+pub use self::params::{glob_match, InputFiles, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};
 pub use self::params_file::{node_fqn, LoadedParams, DEFAULT_NODE_FQN};
 pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, PositionsError, RobotModel};
 pub use self::srdf::{Srdf, SrdfError};

@@ -7,9 +7,19 @@
 //!
 //! Reading the files (which sections apply to the node) is in `params_file`.
 
+use super::bundled::{bundled_environment, bundled_robot};
 use crate::thickness::Side;
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// The command line's file, else the parameter's, else the bundled one.
+fn input_path(over: Option<&Path>, param: &str, bundled: fn() -> PathBuf) -> PathBuf {
+    match over {
+        Some(p) => p.to_owned(),
+        None if param.is_empty() => bundled(),
+        None => PathBuf::from(param),
+    }
+}
 
 /// What to do when a robot state lacks a joint of the model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -145,6 +155,20 @@ pub struct Params {
     pub robot_semantic_file: String,
     /// Check the robot's links against each other.
     pub self_collision: bool,
+    /// Files named on the command line in place of the two above.
+    #[serde(skip)]
+    pub input_files: InputFiles,
+}
+
+/// Input files named on the command line (`--robot`, `--environment`). They override
+/// `robot_description_file` and `environment_file` but are not parameters: a node neither
+/// declares nor serves them, and a parameter change keeps them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct InputFiles {
+    /// The robot's URDF (`--robot`).
+    pub robot: Option<PathBuf>,
+    /// The environment's URDF (`--environment`).
+    pub environment: Option<PathBuf>,
 }
 
 impl Default for Params {
@@ -176,6 +200,7 @@ impl Default for Params {
             clearance_threshold: 0.0,
             robot_semantic_file: String::new(),
             self_collision: true,
+            input_files: InputFiles::default(),
         }
     }
 }
@@ -225,6 +250,22 @@ pub enum ParamsError {
 }
 
 impl Params {
+    /// The robot URDF to load: `--robot`, else `robot_description_file`, else the bundled arm.
+    pub fn robot_path(&self) -> PathBuf {
+        input_path(self.input_files.robot.as_deref(), &self.robot_description_file, bundled_robot)
+    }
+
+    /// The environment URDF to load: `--environment`, else `environment_file`, else the bundled
+    /// workcell.
+    pub fn environment_path(&self) -> PathBuf {
+        input_path(self.input_files.environment.as_deref(), &self.environment_file, bundled_environment)
+    }
+
+    /// Whether no robot file is named, so that the bundled arm stands in.
+    pub fn robot_is_bundled(&self) -> bool {
+        self.input_files.robot.is_none() && self.robot_description_file.is_empty()
+    }
+
     /// Checks every value's domain and the lengths of parallel arrays.
     pub fn validate(&self) -> Result<(), ParamsError> {
         let bad = |name: &str, message: String| Err(ParamsError::Invalid { name: name.into(), message });
@@ -381,7 +422,9 @@ impl Params {
             return Err(invalid("is a group; set its members".into()));
         }
         *at = value;
-        serde_json::from_value(doc).map_err(|e| invalid(e.to_string()))
+        let params: Params = serde_json::from_value(doc).map_err(|e| invalid(e.to_string()))?;
+        // Not parameters, so not in `doc`: setting a parameter keeps them.
+        Ok(Params { input_files: self.input_files.clone(), ..params })
     }
 
     /// These parameters with `-p name:=value` overrides applied (values are YAML, as `ros2 run`

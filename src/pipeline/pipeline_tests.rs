@@ -19,12 +19,12 @@ fn js(names: &[&str], positions: &[f64], ns: i64) -> JointState {
 }
 
 fn pipeline(params: Params) -> Pipeline {
-    Pipeline::new(params, None, None).unwrap()
+    Pipeline::new(params).unwrap()
 }
 
 /// A colliding pose of the bundled arm (the forearm reaches into the guard) and a clear one.
 fn poses() -> ([f64; 7], [f64; 7]) {
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let names: Vec<String> = ARM.iter().map(|s| s.to_string()).collect();
     let mut colliding = None;
     let mut clear = None;
@@ -167,7 +167,7 @@ fn tf_with_a_prefix_gives_the_joint_state_answer_and_foreign_frames_are_skipped(
     let (hit, _) = poses();
     let params = Params { frame_prefix: "robot1/".into(), ..Params::default() };
     let mut p = pipeline(params);
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let by_joints = pipeline(Params::default()).check(&pipeline(Params::default()).joint_state(&js(&ARM, &hit, 7)).unwrap());
     let state = p.tf(&tf_message("robot1/", "world", &checker, &hit, 7)).unwrap();
     let by_tf = p.check(&state);
@@ -204,7 +204,7 @@ fn tf_with_a_prefix_gives_the_joint_state_answer_and_foreign_frames_are_skipped(
 #[test]
 fn world_frame_set_at_run_time_is_used_by_tf_lookups_and_headers() {
     let (hit, _) = poses();
-    let checker = Checker::from_params(Params::default(), None, None).unwrap();
+    let checker = Checker::from_params(Params::default()).unwrap();
     let mut p = pipeline(Params::default());
     let in_map = tf_message("", "map", &checker, &hit, 1);
     assert_eq!(p.tf(&in_map).unwrap_err().cause, SkipCause::Unreachable, "'map' is not the world yet");

@@ -7,12 +7,11 @@ use super::joint_input::JointInput;
 use super::report_adapter::CheckedState;
 use super::skip::{Skip, SkipCause};
 use super::tf_tree::{TfRejection, TfTree};
-use crate::checker::{Checker, CheckerError, StateError, StateReport};
+use crate::checker::{read_semantic_file, Checker, CheckerError, StateError, StateReport};
 use crate::math::Pose;
 use crate::model::Params;
 use crate::msgs::{CollisionReport, Header, JointState, Quaternion, TfMessage, Time, Transform, TransformStamped, Vector3};
 use std::collections::{BTreeMap, HashSet};
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Unknown joint names remembered (to warn once each); past this, new ones are not warned
@@ -22,8 +21,8 @@ const MAX_UNKNOWN_NAMES: usize = 1024;
 /// Where the robot came from: it keeps its source when parameters change.
 #[derive(Clone, Debug)]
 enum RobotSource {
-    /// `--robot`, else the parameters' `robot_description_file`, else the bundled arm.
-    Files { robot: Option<PathBuf> },
+    /// The file the parameters name (see [`Params::robot_path`]).
+    Files,
     /// A `robot_description` message (URDF text) and what to call it in errors.
     Description { urdf: Arc<str>, source: String },
 }
@@ -68,7 +67,6 @@ enum StatePose {
 pub struct Pipeline {
     checker: Arc<Checker>,
     source: RobotSource,
-    environment: Option<PathBuf>,
     joints: JointInput,
     tf: TfTree,
     skipped: BTreeMap<SkipCause, u64>,
@@ -88,19 +86,18 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
-    /// The robot and environment the parameters name (or the overrides), with the bundled
-    /// example workcell as the default for both.
-    pub fn new(params: Params, robot: Option<&Path>, environment: Option<&Path>) -> Result<Pipeline, CheckerError> {
-        let checker = Checker::from_params(params, robot, environment)?;
-        Ok(Self::with_checker(checker, RobotSource::Files { robot: robot.map(Path::to_owned) }, environment.map(Path::to_owned)))
+    /// The robot and environment the parameters name (see [`Params::robot_path`] and
+    /// [`Params::environment_path`]).
+    pub fn new(params: Params) -> Result<Pipeline, CheckerError> {
+        let checker = Checker::from_params(params)?;
+        Ok(Self::with_checker(checker, RobotSource::Files))
     }
 
-    fn with_checker(checker: Checker, source: RobotSource, environment: Option<PathBuf>) -> Pipeline {
+    fn with_checker(checker: Checker, source: RobotSource) -> Pipeline {
         let joints = JointInput::new(&checker);
         Pipeline {
             checker: Arc::new(checker),
             source,
-            environment,
             joints,
             tf: TfTree::default(),
             skipped: BTreeMap::new(),
@@ -118,18 +115,17 @@ impl Pipeline {
     /// an SRDF file that does not fit the bundled arm is not refused here: it is meant for the
     /// robot to come, and is checked against each description as it arrives (one it does not fit
     /// is refused). [`Pipeline::semantic_deferred`] says whether that is waiting.
-    pub fn new_expecting_description(params: Params, robot: Option<&Path>, environment: Option<&Path>) -> Result<Pipeline, CheckerError> {
-        let placeholder = robot.is_none() && params.robot_description_file.is_empty();
-        match Pipeline::new(params.clone(), robot, environment) {
+    pub fn new_expecting_description(params: Params) -> Result<Pipeline, CheckerError> {
+        let placeholder = params.robot_is_bundled();
+        match Pipeline::new(params.clone()) {
             Err(CheckerError::Srdf(_)) if placeholder && !params.robot_semantic_file.is_empty() => {
                 let file = params.robot_semantic_file.clone();
-                let text = crate::limits::read_regular_text(Path::new(&file), "SRDF", crate::limits::MAX_DESCRIPTION_BYTES)
-                    .map_err(|e| CheckerError::Srdf(format!("robot_semantic_file: {e}")))?;
+                let text = read_semantic_file(&file)?;
                 let mut bare = params;
                 bare.robot_semantic_file.clear();
-                let mut checker = Checker::from_params(bare, None, environment)?;
+                let mut checker = Checker::from_params(bare)?;
                 checker.set_semantic_file_name(file.clone());
-                let mut pipeline = Self::with_checker(checker, RobotSource::Files { robot: None }, environment.map(Path::to_owned));
+                let mut pipeline = Self::with_checker(checker, RobotSource::Files);
                 pipeline.semantic = Some((text.into(), file));
                 pipeline.semantic_deferred = true;
                 Ok(pipeline)
@@ -287,15 +283,7 @@ impl Pipeline {
     pub fn robot_urdf(&self) -> Result<String, crate::limits::InputFileError> {
         match &self.source {
             RobotSource::Description { urdf, .. } => Ok(urdf.to_string()),
-            RobotSource::Files { robot } => {
-                let param = &self.params().robot_description_file;
-                let path = match robot {
-                    Some(p) => p.clone(),
-                    None if param.is_empty() => crate::model::bundled_config_dir().join("example_workcell/robot.urdf"),
-                    None => PathBuf::from(param),
-                };
-                crate::limits::read_regular_text(&path, "robot URDF", crate::limits::MAX_DESCRIPTION_BYTES)
-            }
+            RobotSource::Files => crate::limits::read_regular_text(&self.params().robot_path(), "robot URDF", crate::limits::MAX_DESCRIPTION_BYTES),
         }
     }
 
@@ -375,8 +363,7 @@ impl Pipeline {
             // Applied below from the text read at start, where a misfit refuses the robot.
             params.robot_semantic_file.clear();
         }
-        let mut checker =
-            crate::limits::contain_panic(|| Checker::from_description(params, urdf, source, self.environment.as_deref())).map_err(CheckerError::Panicked)??;
+        let mut checker = crate::limits::contain_panic(|| Checker::from_description(params, urdf, source)).map_err(CheckerError::Panicked)??;
         if self.semantic_deferred {
             if let Some((text, file)) = &self.semantic {
                 crate::limits::contain_panic(|| checker.apply_semantic(text, file))
@@ -393,8 +380,10 @@ impl Pipeline {
     }
 
     /// New parameters: the checker is rebuilt with the robot from the same source (a robot
-    /// received as a description stays); on error everything stays as it was.
-    pub fn set_params(&mut self, params: Params) -> Result<(), CheckerError> {
+    /// received as a description stays); on error everything stays as it was. The input files
+    /// the pipeline started with stay: they are not parameters.
+    pub fn set_params(&mut self, mut params: Params) -> Result<(), CheckerError> {
+        params.input_files = self.params().input_files.clone();
         let was_deferred = self.semantic_deferred;
         // A different SRDF file is a new choice, checked against the robot in force.
         if self.semantic.as_ref().is_none_or(|(_, file)| *file != params.robot_semantic_file) {
@@ -449,8 +438,8 @@ impl Pipeline {
 
     fn build_checker(&self, params: Params) -> Result<Checker, CheckerError> {
         crate::limits::contain_panic(|| match &self.source {
-            RobotSource::Files { robot } => Checker::from_params(params, robot.as_deref(), self.environment.as_deref()),
-            RobotSource::Description { urdf, source } => Checker::from_description(params, urdf, source, self.environment.as_deref()),
+            RobotSource::Files => Checker::from_params(params),
+            RobotSource::Description { urdf, source } => Checker::from_description(params, urdf, source),
         })
         .map_err(CheckerError::Panicked)?
     }

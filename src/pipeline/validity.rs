@@ -278,7 +278,7 @@ mod tests {
 
     /// The arm with nothing received yet.
     fn fresh(missing: MissingJoint) -> Pipeline {
-        Pipeline::new(Params { missing_joint: missing, ..Params::default() }, None, None).unwrap()
+        Pipeline::new(Params { missing_joint: missing, ..Params::default() }).unwrap()
     }
 
     /// The arm once its whole state at 0 was received, as a running node has it.

@@ -177,14 +177,8 @@ pub enum ReplayError {
 
 /// Replays a bag, telling `observer` what it does. Reports before a corrupt tail are kept; the
 /// fault is in the summary (`bag_error`), as is a topic of which nothing decoded (`no_input`).
-pub fn replay(
-    params: Params,
-    robot: Option<&Path>,
-    environment: Option<&Path>,
-    opts: &ReplayOptions,
-    observer: &mut dyn ReplayObserver,
-) -> Result<ReplaySummary, ReplayError> {
-    let (mut replayer, bag) = Replayer::open(params, robot, environment, opts, observer)?;
+pub fn replay(params: Params, opts: &ReplayOptions, observer: &mut dyn ReplayObserver) -> Result<ReplaySummary, ReplayError> {
+    let (mut replayer, bag) = Replayer::open(params, opts, observer)?;
     for item in bag {
         match item {
             Ok(m) => replayer.message(m)?,
@@ -215,13 +209,7 @@ struct Replayer<'a> {
 
 impl<'a> Replayer<'a> {
     /// Opens the bag and checks its input topic, loads the robot, creates the outputs.
-    fn open(
-        mut params: Params,
-        robot: Option<&Path>,
-        environment: Option<&Path>,
-        opts: &'a ReplayOptions,
-        observer: &'a mut dyn ReplayObserver,
-    ) -> Result<(Replayer<'a>, BagReader), ReplayError> {
+    fn open(mut params: Params, opts: &'a ReplayOptions, observer: &'a mut dyn ReplayObserver) -> Result<(Replayer<'a>, BagReader), ReplayError> {
         if let Some(p) = opts.pose_source {
             params.pose_source = p;
         }
@@ -242,9 +230,9 @@ impl<'a> Replayer<'a> {
         // it at its log time, as it would replace it in the running node.
         let pipeline = if bag.topics().iter().any(|(t, _)| t == DESCRIPTION_TOPIC) {
             // An SRDF given for the recorded robot is checked against it when it comes.
-            Pipeline::new_expecting_description(params, robot, environment)?
+            Pipeline::new_expecting_description(params)?
         } else {
-            Pipeline::new(params, robot, environment)?
+            Pipeline::new(params)?
         };
         let out = Outputs::create(opts, &bag, &pipeline, pose_source)?;
         let replayer = Replayer {

@@ -17,7 +17,6 @@ use crate::pipeline::Pipeline;
 use anyhow::{anyhow, Context as _, Result};
 use futures::StreamExt;
 use ros2_client::{Context, Node, NodeName};
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -27,10 +26,6 @@ use std::time::{Duration, Instant};
 pub struct RunOptions {
     /// `--ros-args`.
     pub ros_args: RosArgs,
-    /// Robot URDF override (`--robot`).
-    pub robot: Option<PathBuf>,
-    /// Environment URDF override (`--environment`).
-    pub environment: Option<PathBuf>,
 }
 
 /// The loop's housekeeping period (`/rosout`, `/diagnostics`, the summary for a forced stop).
@@ -150,7 +145,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     memory_return::fix_allocator_thresholds();
     let params = params.with_overrides(&opts.ros_args.params)?;
     // The robot may come as a robot_description: an SRDF meant for it waits for it.
-    let pipeline = Pipeline::new_expecting_description(params, opts.robot.as_deref(), opts.environment.as_deref())?;
+    let pipeline = Pipeline::new_expecting_description(params)?;
     let (dp, domain, discovery) = participant()?;
     let context = Context::from_domain_participant(dp).map_err(|e| anyhow!("ROS context: {e:?}"))?;
     let namespace = opts.ros_args.namespace.clone().unwrap_or_else(|| "/".into());

@@ -1,0 +1,114 @@
+//! The checker: a robot, its targets and an environment scene, built together and never changed
+//! after, and what can be read of them.
+
+use super::link_targets::LinkTargets;
+use super::motion_bounds::MotionBounds;
+use super::self_pairs::SelfPairs;
+use crate::collision::{CollideSettings, Scene, Target, TargetReport};
+use crate::model::{Params, RobotModel};
+use nalgebra::Isometry3;
+use std::sync::{Arc, OnceLock};
+
+/// What was loaded (printed by the CLI and the node at start).
+#[derive(Clone, Debug, Default)]
+pub struct BuildSummary {
+    /// Robot file (or `robot_description`).
+    pub robot_source: String,
+    /// Environment file.
+    pub environment_source: String,
+    /// Links of the robot.
+    pub robot_links: usize,
+    /// Links checked (with geometry and matching `checked_links`).
+    pub checked_links: usize,
+    /// Thin surfaces (meshes with cells).
+    pub thin_surfaces: usize,
+    /// Convex solids.
+    pub solids: usize,
+    /// Cells in all thin surfaces.
+    pub cells: usize,
+    /// Mesh files read (each once).
+    pub meshes_read: usize,
+    /// Seconds to load and build everything.
+    pub build_seconds: f64,
+}
+
+/// Robot, environment, targets and scene: everything needed to check a state. Built once from
+/// validated parameters and never changed after (a new robot or new parameters build a new one),
+/// so its parts stay consistent with each other.
+pub struct Checker {
+    pub(super) params: Params,
+    pub(super) robot: RobotModel,
+    pub(super) targets: Vec<LinkTargets>,
+    /// Shared by the checkers that differ only in their self pairs (an SRDF that arrives later).
+    pub(super) scene: Arc<Scene>,
+    pub(super) summary: BuildSummary,
+    pub(super) base: Isometry3<f64>,
+    /// `allowed[target index][object index]`.
+    pub(super) allowed: Vec<Vec<bool>>,
+    /// Levers and grown parts for motion checks, built on the first motion.
+    pub(super) motion: OnceLock<MotionBounds>,
+    /// The link pairs checked against each other.
+    pub(super) self_pairs: SelfPairs,
+    /// `moving[j]`: joint `j` takes a position from joint states and moves a checked link (itself,
+    /// or through a mimic). A state is complete when all of these are known.
+    pub(super) moving: Vec<bool>,
+}
+
+impl Checker {
+    /// The parameters in force.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The robot.
+    pub fn robot(&self) -> &RobotModel {
+        &self.robot
+    }
+
+    /// The checked links' targets, in model order.
+    pub fn targets(&self) -> &[LinkTargets] {
+        &self.targets
+    }
+
+    /// The environment.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// What was loaded.
+    pub fn summary(&self) -> &BuildSummary {
+        &self.summary
+    }
+
+    /// The pose of the robot's root link in the world (`robot_base_pose`).
+    pub fn base_pose(&self) -> &Isometry3<f64> {
+        &self.base
+    }
+
+    /// Whether joint `j` (model index) moves a checked link and takes its position from joint
+    /// states: the joints a state must give before it can be checked.
+    pub fn moves_checked_link(&self, j: usize) -> bool {
+        self.moving.get(j).copied().unwrap_or(false)
+    }
+
+    /// Names `file` as the parameters' SRDF of a checker whose SRDF was applied from text held
+    /// elsewhere (the pipeline's, for a robot that comes as a description).
+    pub(crate) fn set_semantic_file_name(&mut self, file: String) {
+        self.params.robot_semantic_file = file;
+    }
+
+    /// The self-collision pairs and the SRDF they come from.
+    pub fn self_pairs(&self) -> &SelfPairs {
+        &self.self_pairs
+    }
+
+    pub(crate) fn motion_bounds(&self) -> &MotionBounds {
+        self.motion.get_or_init(|| MotionBounds::new(&self.robot, &self.targets, self.params.motion_tolerance))
+    }
+
+    /// Target `ti` (a part of a checked link, posed) against the scene, without the objects the
+    /// link may touch.
+    pub(crate) fn collide_target(&self, ti: usize, target: &Target, settings: &CollideSettings) -> TargetReport {
+        self.scene.collide_filtered(target, settings, |oi| !self.allowed[ti][oi])
+    }
+}
