@@ -123,7 +123,7 @@ impl Scratch {
     pub(super) fn decompress(&mut self, src: &Path, limit: u64) -> Result<PathBuf, String> {
         let io = |what: &str, e: std::io::Error| format!("cannot {what}: {e}");
         let file = crate::limits::open_regular(src, "compressed bag file", u64::MAX).map(|(f, _)| f).map_err(|e| match e {
-            crate::limits::InputFileError::Io { source, .. } => io("open it", source),
+            crate::limits::InputFileError::Io { error, .. } => io("open it", error),
             other => other.to_string(),
         })?;
         let mut input = BufReader::with_capacity(64 << 10, file);

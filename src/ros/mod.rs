@@ -7,6 +7,7 @@
 //! (ros2-client ignores these variables itself, so the participant is built here:
 //! `discovery_range.rs`).
 
+mod description_msg;
 mod diagnostics;
 mod discovery_range;
 mod memory_return;

@@ -7,10 +7,10 @@
 //! current joint state: no geometry) and checked on a worker thread of their own, so a long
 //! trajectory never stalls the live stream; the loop sends the answer when the worker is done.
 
+use super::description_msg::DescriptionMsg;
 use super::diagnostics::{diagnostics, NodeStats};
 use super::discovery_range::DiscoverySettings;
 use super::memory_return::{self, MemoryReturn};
-use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
 use super::param_services::{ros_mapping, ParamRequest, ParamServers};
 use super::param_values::{declarations, to_json, READ_ONLY};
 use super::ros_args::RosArgs;
@@ -20,6 +20,7 @@ use crate::limits::MAX_DESCRIPTION_BYTES;
 use crate::markers::{cell_markers, contact_markers};
 use crate::model::{Params, PoseSource, ServiceMapping};
 use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
+use crate::msgs::{CheckStatesRequest, CheckStatesResponse, ClockMsg};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
 use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause, TrajectoryJob};
 use anyhow::{anyhow, Context as _, Result};

@@ -2,13 +2,10 @@
 //! node's event loop, one request at a time in arrival order. The pipeline decides the answer
 //! ([`crate::pipeline::ValidityJob`]); this only carries jobs in and answers out.
 
-use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
+use crate::msgs::moveit::GetStateValidityResponse;
 use crate::pipeline::ValidityJob;
 use anyhow::{Context as _, Result};
 use ros2_client::service::RmwRequestId;
-
-impl ros2_client::Message for GetStateValidityRequest {}
-impl ros2_client::Message for GetStateValidityResponse {}
 
 /// Requests waiting for or in the worker at most; one past that is answered at once (`valid`
 /// false, the reason "busy" in the log), so a flood cannot queue without bound. A discrete check
