@@ -68,12 +68,13 @@ const QUAD_DAE: &str = r##"<?xml version="1.0" encoding="utf-8"?>
 /// `fuzz/corpus/<target>/` (`scripts/fuzz_campaign.sh` asks it to); the bag seeds, written by
 /// rosbags, are kept in `fuzz/regressions/bag_*/` instead.
 pub fn seeds() -> Vec<Seed> {
-    let mut out: Vec<Seed> = Vec::new();
-    // URDF: the workcell's two files, and a robot of every primitive shape with a mimic joint.
-    out.push(("urdf", "robot.urdf".into(), read_workcell("robot.urdf")));
-    out.push(("urdf", "environment.urdf".into(), read_workcell("environment.urdf")));
-    out.push(("urdf", "shapes.urdf".into(), SHAPES_URDF.as_bytes().to_vec()));
-    out.push(("srdf", "workcell_arm.srdf".into(), WORKCELL_SRDF.as_bytes().to_vec()));
+    let mut out: Vec<Seed> = vec![
+        // URDF: the workcell's two files, and a robot of every primitive shape with a mimic joint.
+        ("urdf", "robot.urdf".into(), read_workcell("robot.urdf")),
+        ("urdf", "environment.urdf".into(), read_workcell("environment.urdf")),
+        ("urdf", "shapes.urdf".into(), SHAPES_URDF.as_bytes().to_vec()),
+        ("srdf", "workcell_arm.srdf".into(), WORKCELL_SRDF.as_bytes().to_vec()),
+    ];
     mesh_seeds(&mut out);
     cdr_seeds(&mut out);
     state_line_seeds(&mut out);
