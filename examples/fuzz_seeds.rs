@@ -1,11 +1,11 @@
-//! Writes the generated fuzz seed corpus (`thickness_collision::fuzz_entry::seeds`: states,
+//! Writes the generated fuzz seed corpus (`fuzz_harness::seeds`: states,
 //! messages, meshes and parameters built from the bundled workcell) to `DIR/<target>/`, for
 //! `scripts/fuzz_campaign.sh`.
 //!
 //! `cargo run --example fuzz_seeds -- DIR` (default `fuzz/corpus`).
 
+use fuzz_harness::seeds;
 use std::path::PathBuf;
-use thickness_collision::fuzz_entry::seeds;
 
 fn main() -> std::io::Result<()> {
     let root = std::env::args_os().nth(1).map(PathBuf::from).unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fuzz").join("corpus"));

@@ -1,5 +1,7 @@
 //! The `areas` command end to end: real files in, report and JSON out, clear errors with exit 2.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -8,9 +10,7 @@ fn bin() -> Command {
 }
 
 fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tc_cli_areas_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch_dir("cli_areas").join(name)
 }
 
 /// A binary STL whose 80-byte header starts with `solid`, the case mesh-loader rejects.

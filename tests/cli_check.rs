@@ -1,6 +1,8 @@
 //! The `check` command on the bundled workcell: JSON lines, the same answer from every input
 //! form, and every kind of bad input as a one-line error naming it, with exit code 2.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -9,9 +11,7 @@ fn bin() -> Command {
 }
 
 fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tc_cli_check_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch_dir("cli_check").join(name)
 }
 
 fn ok(out: Output) -> String {

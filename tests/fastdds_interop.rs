@@ -36,9 +36,7 @@ fn state_json(k: usize, stamp: i64) -> Value {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tc_fastdds_{name}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch_dir(&format!("fastdds_{name}"))
 }
 
 /// `check --states FILE --json` (plus `extra`) on JSON lines; one report per line.

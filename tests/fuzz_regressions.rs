@@ -1,11 +1,11 @@
 //! Replays every input saved under `fuzz/regressions/<target>/` (crashes the fuzzer found, and a
 //! few small seeds) through the same entry function its `cargo fuzz` target calls
-//! (`thickness_collision::fuzz_entry`), on stable: none may panic. See docs/fuzzing.md.
+//! (`fuzz_harness`, in fuzz/harness), on stable: none may panic. See docs/fuzzing.md.
 //!
 //! `examples/fuzz_seeds.rs` writes the generated seed corpus for `scripts/fuzz_campaign.sh`.
 
+use fuzz_harness::{seeds, TARGETS};
 use std::path::{Path, PathBuf};
-use thickness_collision::fuzz_entry::{seeds, TARGETS};
 
 fn regressions_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz").join("regressions")
@@ -67,7 +67,7 @@ fn generated_seeds_run_without_panic() {
 /// bundled robot can check, and the state-line seeds are checked without an error.
 #[test]
 fn seeds_reach_checked_states() {
-    use thickness_collision::fuzz_entry::{split_records, CdrKind};
+    use fuzz_harness::{split_records, CdrKind};
     use thickness_collision::model::Params;
     use thickness_collision::msgs::{JointState, TfMessage};
     use thickness_collision::pipeline::{parse_state_line, Pipeline};
@@ -94,4 +94,62 @@ fn seeds_reach_checked_states() {
         let checked = pipeline.check_line(parse_state_line(std::str::from_utf8(&line).expect("UTF-8")).expect("a state line"));
         assert!(checked.report.error.is_empty(), "{name}: {}", checked.report.error);
     }
+}
+
+#[test]
+fn the_srdf_seed_parses_against_the_bundled_arm() {
+    let seeds = seeds();
+    let (_, _, bytes) = seeds.iter().find(|(t, _, _)| *t == "srdf").expect("an srdf seed");
+    let text = std::str::from_utf8(bytes).unwrap();
+    let model = thickness_collision::model::Srdf::parse(text, "seed", fuzz_harness::workcell().checker().robot()).unwrap();
+    assert_eq!(model.group_names(), vec!["all", "arm", "hand"]);
+    fuzz_harness::srdf(bytes);
+}
+
+#[test]
+fn trajectory_seeds_decode_and_reach_the_check() {
+    use thickness_collision::msgs::CheckTrajectoryRequest;
+    use thickness_collision::replay::decode_cdr;
+    let mut seen = 0;
+    for (_, name, bytes) in seeds().into_iter().filter(|s| s.0 == "check_trajectory") {
+        let request = decode_cdr::<CheckTrajectoryRequest>(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let a = fuzz_harness::workcell().check_trajectory(&request.trajectory);
+        match name.as_str() {
+            "every_joint.cdr" => assert!(a.valid || a.segment >= 0, "{name}: {a:?}"),
+            "into_guard.cdr" => assert!(!a.valid && a.segment >= 0 && a.error.is_empty() && !a.contacts.is_empty(), "{name}: {a:?}"),
+            "one_point.cdr" => assert!(!a.valid && a.segment == 0 && a.fraction == 0.0, "{name}: {a:?}"),
+            _ => assert!(!a.valid && a.segment == -1 && !a.error.is_empty(), "{name}: {a:?}"),
+        }
+        seen += 1;
+    }
+    assert_eq!(seen, 7);
+}
+
+#[test]
+fn validity_seeds_decode_and_reach_the_check() {
+    use thickness_collision::msgs::moveit::GetStateValidityRequest;
+    use thickness_collision::replay::decode_cdr;
+    let mut seen = 0;
+    for (_, name, bytes) in seeds().into_iter().filter(|s| s.0 == "check_state_validity") {
+        let request = decode_cdr::<GetStateValidityRequest>(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let (a, reason) = fuzz_harness::workcell().check_validity(&request);
+        fuzz_harness::assert_validity_answer(&a, reason.as_deref());
+        match name.as_str() {
+            "every_joint.cdr" | "partial.cdr" => assert!(reason.is_none(), "{name}: {reason:?}"),
+            "into_guard.cdr" | "group.cdr" => assert!(!a.valid && reason.is_none() && !a.contacts.is_empty(), "{name}: {a:?}"),
+            _ => assert!(reason.is_some(), "{name}: {a:?}"),
+        }
+        seen += 1;
+    }
+    assert_eq!(seen, 9);
+}
+
+#[test]
+fn records_split_back() {
+    use fuzz_harness::{cdr_records, split_records, CdrKind};
+    let input = cdr_records(&[(CdrKind::Tf, vec![1, 2, 3]), (CdrKind::Clock, vec![])]);
+    assert_eq!(split_records(&input), vec![(CdrKind::Tf, &[1u8, 2, 3][..]), (CdrKind::Clock, &[][..])]);
+    // A length past the end takes the rest; a lone kind byte is an empty record.
+    assert_eq!(split_records(&[4, 9, 0, 7]), vec![(CdrKind::CheckStates, &[7u8][..])]);
+    assert_eq!(split_records(&[6]), vec![(CdrKind::JointStates, &[][..])]);
 }

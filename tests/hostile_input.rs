@@ -65,9 +65,7 @@ fn refused(r: &Run, needles: &[&str]) -> String {
 }
 
 fn scratch() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tc_hostile_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch_dir("hostile")
 }
 
 fn write(name: &str, text: impl AsRef<[u8]>) -> PathBuf {

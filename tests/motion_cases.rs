@@ -3,6 +3,8 @@
 //! (what swept-hull checkers miss); and the bundled arm's continuous, prismatic and mimic joints,
 //! against dense sampling that interpolates them the same way (shorter arc, mimic from master).
 
+mod common;
+
 use oorandom::Rand64;
 use parry3d_f64::query;
 use parry3d_f64::shape::ConvexPolyhedron;
@@ -11,9 +13,8 @@ use std::process::Command;
 use thickness_collision::checker::Checker;
 use thickness_collision::collision::Scene;
 use thickness_collision::math::{Pose, Rotation, Vector};
-use thickness_collision::mesh::{generate, MeshTopology, TopologySettings};
+use thickness_collision::mesh::generate;
 use thickness_collision::model::{JointKind, PackageResolver, Params, RobotModel};
-use thickness_collision::thickness::{ThicknessArea, ThicknessSettings};
 
 /// Positions along a motion as `check_motion` defines it: continuous joints by the shorter arc,
 /// mimic joints from their master.
@@ -96,8 +97,7 @@ fn a_rotating_link_leaving_the_hull_of_its_end_poses_is_caught() {
 <joint name="turn" type="revolute"><parent link="base"/><child link="bar"/><axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint></robot>"#;
     let robot = RobotModel::from_str(urdf, "bar.urdf", Path::new("."), &PackageResolver::default(), false).unwrap();
     let (v, t) = generate::flat_grid(4, 4, 0.6, 0.6);
-    let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).unwrap();
-    let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: 0.01, ..Default::default() }).unwrap();
+    let area = common::thin_area(&v, &t, 0.01);
     // The grid lies in z = 0 around the origin; stood up at x = 0.8, facing -x.
     let sheet_pose = Pose::from_parts(Vector::new(0.8, 0.0, 0.0), Rotation::from_rotation_y(std::f64::consts::FRAC_PI_2));
     let mut scene = Scene::new();

@@ -5,14 +5,15 @@
 //! an oracle that samples each motion densely (every point of the bar moves less than 1 mm
 //! between samples), interpolating with glam's own slerp.
 
+mod common;
+
 use oorandom::Rand64;
 use std::path::Path;
 use thickness_collision::checker::Checker;
 use thickness_collision::collision::Scene;
 use thickness_collision::math::{Pose, Rotation, Vector};
-use thickness_collision::mesh::{generate, MeshTopology, TopologySettings};
+use thickness_collision::mesh::generate;
 use thickness_collision::model::{PackageResolver, Params, RobotModel};
-use thickness_collision::thickness::{ThicknessArea, ThicknessSettings};
 
 /// A 1 m bar (4 cm square) from its link's origin along +x, and a 0.6 m sheet standing at
 /// x = 0.8 (1 cm thick), as in tests/motion_cases.rs.
@@ -21,8 +22,7 @@ fn bar_and_sheet() -> Checker {
 <joint name="turn" type="revolute"><parent link="base"/><child link="bar"/><axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint></robot>"#;
     let robot = RobotModel::from_str(urdf, "bar.urdf", Path::new("."), &PackageResolver::default(), false).unwrap();
     let (v, t) = generate::flat_grid(6, 6, 0.6, 0.6);
-    let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).unwrap();
-    let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: 0.01, ..Default::default() }).unwrap();
+    let area = common::thin_area(&v, &t, 0.01);
     let sheet_pose = Pose::from_parts(Vector::new(0.8, 0.0, 0.0), Rotation::from_rotation_y(std::f64::consts::FRAC_PI_2));
     let mut scene = Scene::new();
     let _ = scene.add_surface("sheet", sheet_pose, area);

@@ -17,8 +17,7 @@ use thickness_collision::checker::Checker;
 use thickness_collision::model::{JointKind, Params};
 
 fn scratch(name: &str) -> (PathBuf, PathBuf) {
-    let dir = std::env::temp_dir().join(format!("tc_ros_trajectory_{name}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir(&format!("ros_trajectory_{name}"));
     let cyclone = common::cyclone_loopback_file(&dir);
     (dir, cyclone)
 }

@@ -16,12 +16,6 @@ use thickness_collision::checker::{Checker, ObjectType};
 use thickness_collision::collision::{Scene, TargetShape};
 use thickness_collision::model::{PackageResolver, Params, RobotModel};
 
-fn write_raw<T: Copy>(path: &Path, data: &[T]) {
-    // Plain little-endian arrays (this machine is little endian, as the reader assumes).
-    let bytes = unsafe { std::slice::from_raw_parts(data.as_ptr() as *const u8, std::mem::size_of_val(data)) };
-    std::fs::write(path, bytes).unwrap();
-}
-
 struct Outcome {
     states: usize,
     colliding_pairs: usize,
@@ -79,10 +73,10 @@ fn compare(name: &str, urdf: &str, srdf: &str, n: usize, seed: u64) -> Outcome {
         };
         kinds.push(serde_json::json!("hull"));
         let (pts, tri) = hull.vertices_and_triangles();
-        write_raw(&dir.join(format!("part{k}_vertices.f64")), &pts);
-        write_raw(&dir.join(format!("part{k}_triangles.u32")), &tri);
+        common::write_le(&dir.join(format!("part{k}_vertices.f64")), &pts);
+        common::write_le(&dir.join(format!("part{k}_triangles.u32")), &tri);
     }
-    write_raw(&dir.join("pairs.u32"), &part_pairs);
+    common::write_le(&dir.join("pairs.u32"), &part_pairs);
 
     // Random states within the limits, fixed seed; ours, and the part poses for coal.
     let mut rng = Rand64::new(seed as u128);
@@ -125,7 +119,7 @@ fn compare(name: &str, urdf: &str, srdf: &str, n: usize, seed: u64) -> Outcome {
         }
     }
     assert_eq!(disabled_reported.get(), 0, "{name}: a pair the SRDF disables was reported");
-    write_raw(&dir.join("poses.f64"), &poses);
+    common::write_le(&dir.join("poses.f64"), &poses);
     std::fs::write(dir.join("meta.json"), serde_json::json!({"states": n, "parts": parts.len(), "kinds": kinds}).to_string()).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/peers/self_pairs_coal.py");
     let out = Command::new(common::python()).arg(&script).arg(&dir).output().unwrap();

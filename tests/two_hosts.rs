@@ -60,9 +60,7 @@ fn run_peer_in_b(hosts: &TwoHosts, config: &str, request: &Value) -> Value {
 }
 
 fn scratch() -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("tc_two_hosts_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch_dir("two_hosts")
 }
 
 /// A state of the bundled arm (the same walk as `tests/ros_node.rs`: some collide, some not).

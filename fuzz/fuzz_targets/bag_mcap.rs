@@ -1,4 +1,4 @@
-//! Fuzz target `bag_mcap`: see `thickness_collision::fuzz_entry::bag_mcap` and docs/fuzzing.md.
+//! Fuzz target `bag_mcap`: see `fuzz_harness::bag_mcap` and docs/fuzzing.md.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::bag_mcap(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz_harness::bag_mcap(data));

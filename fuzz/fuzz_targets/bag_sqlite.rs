@@ -1,4 +1,4 @@
-//! Fuzz target `bag_sqlite`: see `thickness_collision::fuzz_entry::bag_sqlite` and docs/fuzzing.md.
+//! Fuzz target `bag_sqlite`: see `fuzz_harness::bag_sqlite` and docs/fuzzing.md.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::bag_sqlite(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz_harness::bag_sqlite(data));

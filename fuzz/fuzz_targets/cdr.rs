@@ -1,4 +1,4 @@
-//! Fuzz target `cdr`: see `thickness_collision::fuzz_entry::cdr` and docs/fuzzing.md.
+//! Fuzz target `cdr`: see `fuzz_harness::cdr` and docs/fuzzing.md.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::cdr(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz_harness::cdr(data));

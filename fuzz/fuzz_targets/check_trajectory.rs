@@ -1,4 +1,4 @@
-//! Fuzz target `check_trajectory`: see `thickness_collision::fuzz_entry::check_trajectory` and docs/fuzzing.md.
+//! Fuzz target `check_trajectory`: see `fuzz_harness::check_trajectory` and docs/fuzzing.md.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::check_trajectory(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz_harness::check_trajectory(data));

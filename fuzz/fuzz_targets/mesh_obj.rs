@@ -1,4 +1,4 @@
-//! Fuzz target `mesh_obj`: see `thickness_collision::fuzz_entry::mesh_obj` and docs/fuzzing.md.
+//! Fuzz target `mesh_obj`: see `fuzz_harness::mesh_obj` and docs/fuzzing.md.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::mesh_obj(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz_harness::mesh_obj(data));

@@ -1,4 +1,4 @@
-//! Fuzz target `params_yaml`: see `thickness_collision::fuzz_entry::params_yaml` and docs/fuzzing.md.
+//! Fuzz target `params_yaml`: see `fuzz_harness::params_yaml` and docs/fuzzing.md.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::params_yaml(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz_harness::params_yaml(data));

@@ -1,4 +1,4 @@
-//! Fuzz target `srdf`: see `thickness_collision::fuzz_entry::srdf` and docs/fuzzing.md.
+//! Fuzz target `srdf`: see `fuzz_harness::srdf` and docs/fuzzing.md.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::srdf(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz_harness::srdf(data));

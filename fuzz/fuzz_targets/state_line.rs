@@ -1,4 +1,4 @@
-//! Fuzz target `state_line`: see `thickness_collision::fuzz_entry::state_line` and docs/fuzzing.md.
+//! Fuzz target `state_line`: see `fuzz_harness::state_line` and docs/fuzzing.md.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::state_line(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz_harness::state_line(data));

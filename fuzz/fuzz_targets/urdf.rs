@@ -1,4 +1,4 @@
-//! Fuzz target `urdf`: see `thickness_collision::fuzz_entry::urdf` and docs/fuzzing.md.
+//! Fuzz target `urdf`: see `fuzz_harness::urdf` and docs/fuzzing.md.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| thickness_collision::fuzz_entry::urdf(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz_harness::urdf(data));

@@ -7,9 +7,11 @@
 //! order, and the replay tests read what `replay` writes back with rosbags.
 
 mod bounded;
+mod check_states;
 mod definitions;
 pub mod moveit;
 
+pub use self::check_states::{CheckStatesRequest, CheckStatesResponse};
 pub use self::definitions::{full_definition, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};
 
 use serde::{Deserialize, Deserializer, Serialize};
@@ -43,6 +45,13 @@ impl Time {
     pub fn as_nanos(&self) -> i64 {
         self.sec as i64 * 1_000_000_000 + self.nanosec as i64
     }
+}
+
+/// `rosgraph_msgs/msg/Clock` (`/clock`, read under `use_sim_time`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ClockMsg {
+    /// Simulated time.
+    pub clock: Time,
 }
 
 /// `std_msgs/msg/Header`.

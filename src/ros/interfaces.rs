@@ -3,11 +3,12 @@
 //! the loop. A new topic or service is a name in [`Names`], a field in [`Interfaces`], one line
 //! in [`Interfaces::build`] and, for an input, one in [`Interfaces::events`].
 
-use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, ClockMsg, DescriptionMsg};
+use super::description_msg::DescriptionMsg;
 use super::param_services::{ros_mapping, ParamRequest};
 use super::ros_args::RosArgs;
 use crate::model::{Params, PoseSource};
 use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
+use crate::msgs::{CheckStatesRequest, CheckStatesResponse, ClockMsg};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
 use anyhow::{anyhow, Result};
 use futures::stream::Stream;

@@ -1,11 +1,13 @@
-//! The shared message types are ROS messages for ros2-client, and the node's own: the
-//! `check_states` service, `/clock`, and `robot_description` decoded with its size bound (the
-//! `check_trajectory` and `check_state_validity` types live in `msgs`, beside what they carry).
+//! Every type the node sends or receives is a ROS message for ros2-client: the shared message
+//! types of `msgs` (the node's own services among them) and the node's bounded decoding of
+//! `robot_description`.
 
-use crate::limits::MAX_DESCRIPTION_BYTES;
+use super::description_msg::DescriptionMsg;
 use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
-use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, StringMsg, TfMessage};
-use serde::{Deserialize, Serialize};
+use crate::msgs::{
+    CheckStatesRequest, CheckStatesResponse, CheckTrajectoryRequest, CheckTrajectoryResponse, ClockMsg, CollisionReport, DiagnosticArray, JointState,
+    MarkerArray, StringMsg, TfMessage,
+};
 
 impl ros2_client::Message for JointState {}
 impl ros2_client::Message for CollisionReport {}
@@ -15,132 +17,9 @@ impl ros2_client::Message for MarkerArray {}
 impl ros2_client::Message for DiagnosticArray {}
 impl ros2_client::Message for CheckTrajectoryRequest {}
 impl ros2_client::Message for CheckTrajectoryResponse {}
+impl ros2_client::Message for CheckStatesRequest {}
+impl ros2_client::Message for CheckStatesResponse {}
+impl ros2_client::Message for ClockMsg {}
 impl ros2_client::Message for GetStateValidityRequest {}
 impl ros2_client::Message for GetStateValidityResponse {}
-
-/// `thickness_collision_msgs/srv/CheckStates` request.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct CheckStatesRequest {
-    /// The states to check.
-    pub states: Vec<JointState>,
-}
-impl ros2_client::Message for CheckStatesRequest {}
-
-/// `thickness_collision_msgs/srv/CheckStates` response.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct CheckStatesResponse {
-    /// One report per state, in order.
-    pub reports: Vec<CollisionReport>,
-}
-impl ros2_client::Message for CheckStatesResponse {}
-
-/// `rosgraph_msgs/msg/Clock`.
-#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
-pub struct ClockMsg {
-    /// Simulated time.
-    pub clock: crate::msgs::Time,
-}
-impl ros2_client::Message for ClockMsg {}
-
-/// `std_msgs/msg/String` on `robot_description`, its length checked before the text is copied out
-/// of the DDS sample: text past [`MAX_DESCRIPTION_BYTES`] comes back as
-/// [`DescriptionMsg::TooLarge`] (to be refused with the bound in the error), so a 50 MB
-/// description costs the node its sample, never a second copy.
-#[derive(Clone, Debug, PartialEq)]
-pub enum DescriptionMsg {
-    /// URDF text within the bound.
-    Text(String),
-    /// Text of this many bytes, past the bound.
-    TooLarge(usize),
-}
 impl ros2_client::Message for DescriptionMsg {}
-
-impl Serialize for DescriptionMsg {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::{Error, SerializeStruct};
-        let mut s = serializer.serialize_struct("String", 1)?;
-        match self {
-            DescriptionMsg::Text(text) => s.serialize_field("data", text)?,
-            DescriptionMsg::TooLarge(n) => return Err(S::Error::custom(format!("a description of {n} bytes was not kept, so cannot be sent"))),
-        }
-        s.end()
-    }
-}
-
-/// The `data` field: checked on the borrowed text, copied only when within the bound.
-struct BoundedText;
-
-impl BoundedText {
-    fn of(text: &str) -> DescriptionMsg {
-        if text.len() as u64 > MAX_DESCRIPTION_BYTES {
-            DescriptionMsg::TooLarge(text.len())
-        } else {
-            DescriptionMsg::Text(text.to_owned())
-        }
-    }
-}
-
-impl<'de> serde::de::DeserializeSeed<'de> for BoundedText {
-    type Value = DescriptionMsg;
-    fn deserialize<D: serde::Deserializer<'de>>(self, deserializer: D) -> Result<DescriptionMsg, D::Error> {
-        deserializer.deserialize_str(self)
-    }
-}
-
-impl serde::de::Visitor<'_> for BoundedText {
-    type Value = DescriptionMsg;
-    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        f.write_str("URDF text")
-    }
-    fn visit_str<E: serde::de::Error>(self, text: &str) -> Result<DescriptionMsg, E> {
-        Ok(Self::of(text))
-    }
-}
-
-impl<'de> Deserialize<'de> for DescriptionMsg {
-    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<DescriptionMsg, D::Error> {
-        struct Fields;
-        impl<'de> serde::de::Visitor<'de> for Fields {
-            type Value = DescriptionMsg;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a std_msgs/msg/String")
-            }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<DescriptionMsg, A::Error> {
-                seq.next_element_seed(BoundedText)?.ok_or_else(|| serde::de::Error::invalid_length(0, &self))
-            }
-        }
-        deserializer.deserialize_struct("String", &["data"], Fields)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use byteorder::LittleEndian;
-
-    fn cdr(text: &str) -> Vec<u8> {
-        cdr_encoding::to_vec::<_, LittleEndian>(&StringMsg { data: text.to_owned() }).unwrap()
-    }
-
-    #[test]
-    fn a_description_decodes_as_a_string_does() {
-        let (m, _) = cdr_encoding::from_bytes::<DescriptionMsg, LittleEndian>(&cdr("<robot name='r'/>")).unwrap();
-        assert_eq!(m, DescriptionMsg::Text("<robot name='r'/>".into()));
-        let back = cdr_encoding::to_vec::<_, LittleEndian>(&m).unwrap();
-        assert_eq!(back, cdr("<robot name='r'/>"));
-    }
-
-    #[test]
-    fn a_description_past_the_bound_is_not_copied() {
-        let big = " ".repeat(MAX_DESCRIPTION_BYTES as usize + 1);
-        let (m, _) = cdr_encoding::from_bytes::<DescriptionMsg, LittleEndian>(&cdr(&big)).unwrap();
-        assert_eq!(m, DescriptionMsg::TooLarge(big.len()));
-        // A length past the bytes present, and text that is not UTF-8, do not decode.
-        let mut cut = cdr("<robot/>");
-        cut.truncate(6);
-        assert!(cdr_encoding::from_bytes::<DescriptionMsg, LittleEndian>(&cut).is_err());
-        let mut bad = cdr("<robot/>");
-        bad[5] = 0xff;
-        assert!(cdr_encoding::from_bytes::<DescriptionMsg, LittleEndian>(&bad).is_err());
-    }
-}

@@ -3,16 +3,17 @@
 //! answer, and nothing here waits: the loop (`node_run.rs`) or the receiving thread
 //! (`states_on_receive.rs`) calls a handler with the state held.
 
+use super::description_msg::DescriptionMsg;
 use super::diagnostics::{diagnostics, NodeStats};
 use super::interfaces::{Event, Interfaces};
 use super::memory_return::MemoryReturn;
-use super::msg_impls::{CheckStatesRequest, CheckStatesResponse, DescriptionMsg};
 use super::rate_limited_log::RateLimitedLog;
 use super::workers::Workers;
 use crate::limits::MAX_DESCRIPTION_BYTES;
 use crate::markers::{cell_markers, contact_markers};
 use crate::model::Params;
 use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
+use crate::msgs::{CheckStatesRequest, CheckStatesResponse};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, JointState, TfMessage, Time};
 use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause};
 use ros2_client::service::RmwRequestId;

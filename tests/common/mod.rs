@@ -9,6 +9,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, Stdio};
 
 pub mod netns;
+mod scaffold;
+
+// Each test binary uses some of these.
+#[allow(unused_imports)]
+pub use self::scaffold::{mesh_area, scratch_dir, thin_area, topology, write_le, LeBytes};
 
 /// A Cyclone DDS configuration that keeps a peer on loopback: `NetworkInterface 127.0.0.1`, no
 /// multicast, the peer 127.0.0.1 (the network rule in the design notes).

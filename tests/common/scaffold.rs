@@ -1,0 +1,71 @@
+//! Scaffolding every kind of test uses: a scratch folder per test file, raw little-endian arrays
+//! for the Python peers, and a thickness area straight from a triangle soup.
+
+use std::path::{Path, PathBuf};
+use thickness_collision::math::{Real, Vector};
+use thickness_collision::mesh::{MeshTopology, TopologySettings};
+use thickness_collision::thickness::{ThicknessArea, ThicknessSettings};
+
+/// `<temp>/tc_<name>_<pid>`, created: the scratch folder of one test binary (the process id keeps
+/// two runs at a time apart; `name` keeps the test files apart).
+pub fn scratch_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tc_{name}_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
+    dir
+}
+
+/// A value written as its little-endian bytes, as the peers' `numpy.fromfile` reads them.
+pub trait LeBytes {
+    /// Appends the bytes of `self`.
+    fn put_le(&self, out: &mut Vec<u8>);
+}
+
+impl LeBytes for f64 {
+    fn put_le(&self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl LeBytes for f32 {
+    fn put_le(&self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl LeBytes for u32 {
+    fn put_le(&self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl<T: LeBytes, const N: usize> LeBytes for [T; N] {
+    fn put_le(&self, out: &mut Vec<u8>) {
+        for v in self {
+            v.put_le(out);
+        }
+    }
+}
+
+/// Writes `data` as a plain little-endian array (no header, no padding).
+pub fn write_le<T: LeBytes>(path: &Path, data: &[T]) {
+    let mut bytes = Vec::with_capacity(std::mem::size_of_val(data));
+    for v in data {
+        v.put_le(&mut bytes);
+    }
+    std::fs::write(path, bytes).unwrap_or_else(|e| panic!("cannot write {}: {e}", path.display()));
+}
+
+/// The topology of a triangle soup with the default settings; panics if it does not build.
+pub fn topology(vertices: &[Vector], triangles: &[[u32; 3]]) -> MeshTopology {
+    MeshTopology::build(vertices, triangles, &TopologySettings::default()).expect("the mesh builds")
+}
+
+/// The thickness area of a triangle soup (default topology settings); panics if it does not build.
+pub fn mesh_area(vertices: &[Vector], triangles: &[[u32; 3]], settings: &ThicknessSettings) -> ThicknessArea {
+    ThicknessArea::build(&topology(vertices, triangles), settings).expect("the cells build")
+}
+
+/// [`mesh_area`] with only the thickness set (metres).
+pub fn thin_area(vertices: &[Vector], triangles: &[[u32; 3]], thickness: Real) -> ThicknessArea {
+    mesh_area(vertices, triangles, &ThicknessSettings { thickness, ..Default::default() })
+}
