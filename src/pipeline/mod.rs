@@ -9,6 +9,7 @@
 //! answer is owed (a service slot, a `check` line) fails closed (`in_collision` and `error`).
 
 mod joint_input;
+mod link_transforms;
 mod report_adapter;
 mod skip;
 mod state_line;
@@ -20,7 +21,8 @@ mod validity;
 pub use self::report_adapter::{report_message, CheckedState};
 pub use self::skip::{Skip, SkipCause};
 pub use self::state_line::{parse_state_line, LinkTransform, StateLine};
-pub use self::state_pipeline::{link_transforms, Pipeline, RobotState};
+pub use self::link_transforms::link_transforms;
+pub use self::state_pipeline::{Pipeline, RobotState};
 pub use self::trajectory::{TrajectoryJob, MAX_TRAJECTORY_NAMES, MAX_TRAJECTORY_POINTS, MAX_TRAJECTORY_SUBINTERVALS};
 pub use self::validity::ValidityJob;
 
