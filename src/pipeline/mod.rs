@@ -18,10 +18,10 @@ mod tf_tree;
 mod trajectory;
 mod validity;
 
+pub use self::link_transforms::link_transforms;
 pub use self::report_adapter::{report_message, CheckedState};
 pub use self::skip::{Skip, SkipCause};
 pub use self::state_line::{parse_state_line, LinkTransform, StateLine};
-pub use self::link_transforms::link_transforms;
 pub use self::state_pipeline::{Pipeline, RobotState};
 pub use self::trajectory::{TrajectoryJob, MAX_TRAJECTORY_NAMES, MAX_TRAJECTORY_POINTS, MAX_TRAJECTORY_SUBINTERVALS};
 pub use self::validity::ValidityJob;
