@@ -78,9 +78,7 @@ pub(crate) fn resolve_positions(model: &RobotModel, names: &[String], positions:
             return Err(StateError::Duplicate(name.clone()));
         }
     }
-    if !q.iter().zip(&model.joints).any(|(v, j)| v.is_some() && j.is_actuated()) {
-        return Err(not_our_robot(model, names));
-    }
+    require_own_joints(model, q.iter().enumerate().filter(|(_, v)| v.is_some()).map(|(j, _)| j), names)?;
     model
         .joints
         .iter()
@@ -93,13 +91,17 @@ pub(crate) fn resolve_positions(model: &RobotModel, names: &[String], positions:
         .collect()
 }
 
-/// The error for a state that gives no position to any of `model`'s actuated joints. A robot
-/// with no actuated joint has only the one pose, which any state stands for.
-pub(crate) fn not_our_robot(model: &RobotModel, names: &[String]) -> StateError {
+/// Refuses a state whose named joints (`given`, model indices) hold none of `model`'s actuated
+/// joints: an empty state, or another robot's. A robot with no actuated joint has only the one
+/// pose, which any state stands for.
+pub(crate) fn require_own_joints(model: &RobotModel, mut given: impl Iterator<Item = usize>, names: &[String]) -> Result<(), StateError> {
     let actuated = model.joints.iter().filter(|j| j.is_actuated()).count();
+    if actuated == 0 || given.any(|j| model.joints[j].is_actuated()) {
+        return Ok(());
+    }
     let what = match names.first() {
         None => "the joint state names no joint".to_owned(),
         Some(first) => format!("the joint state names none of the {actuated} moving joints of robot '{}' (e.g. '{first}')", model.name),
     };
-    StateError::NotOurRobot(format!("{what}: another robot's state cannot be checked as this one's"))
+    Err(StateError::NotOurRobot(format!("{what}: another robot's state cannot be checked as this one's")))
 }

@@ -24,7 +24,7 @@ mod world_motion;
 pub use self::checker::{BuildSummary, Checker};
 pub(crate) use self::checker_build::read_semantic_file;
 pub use self::checker_error::CheckerError;
-pub(crate) use self::joint_state::not_our_robot;
+pub(crate) use self::joint_state::require_own_joints;
 pub use self::joint_state::StateError;
 pub use self::link_targets::LinkTargets;
 pub use self::motion_sweep::{MotionReport, MAX_SUBINTERVALS};

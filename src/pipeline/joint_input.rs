@@ -49,10 +49,7 @@ impl JointInput {
                 None => {}
             }
         }
-        let actuated = robot.joints.iter().any(|j| j.is_actuated());
-        if actuated && !given.iter().any(|&(j, _)| robot.joints[j].is_actuated()) {
-            return Err(crate::checker::not_our_robot(robot, names));
-        }
+        crate::checker::require_own_joints(robot, given.iter().map(|&(j, _)| j), names)?;
         if missing == MissingJoint::Zero {
             self.received.iter_mut().for_each(|v| *v = None);
         }

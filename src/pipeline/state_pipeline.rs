@@ -9,7 +9,7 @@ use super::skip::{Skip, SkipCause};
 use super::tf_tree::{TfRejection, TfTree};
 use crate::checker::{read_semantic_file, Checker, CheckerError, StateError, StateReport};
 use crate::math::Pose;
-use crate::model::Params;
+use crate::model::{MissingJoint, Params};
 use crate::msgs::{CollisionReport, JointState, TfMessage, Time};
 use std::collections::{BTreeMap, HashSet};
 use std::sync::Arc;
@@ -466,9 +466,25 @@ impl Pipeline {
         self.trail = None;
     }
 
-    /// The merged joint positions received so far, by joint index (`None`: none yet).
-    pub(crate) fn current_joints(&self) -> &[Option<f64>] {
-        self.joints.current()
+    /// The position of joint `j` for a request that leaves it out (`check_trajectory`,
+    /// `check_state_validity`): the merged state, else the `missing_joint` rule. `request` says
+    /// where the joint was looked for, for the error. Under `last` a joint that moves a checked
+    /// link and was never received leaves the pose unknown: checking it at 0 could call a
+    /// colliding request free.
+    pub(crate) fn left_out_position(&self, j: usize, request: &str) -> Result<f64, String> {
+        let joint = &self.checker.robot().joints[j];
+        let missing = self.params().missing_joint;
+        match self.joints.current()[j] {
+            Some(v) => Ok(v),
+            None if joint.is_actuated() && missing == MissingJoint::Reject => {
+                Err(format!("joint '{}' is neither in {request} nor in a joint state received so far (missing_joint: reject)", joint.name))
+            }
+            None if missing == MissingJoint::Last && self.checker.moves_checked_link(j) => Err(format!(
+                "joint '{}' is neither in {request} nor in a joint state received so far (missing_joint: last takes it from the joint states)",
+                joint.name
+            )),
+            None => Ok(0.0),
+        }
     }
 }
 

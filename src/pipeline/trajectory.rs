@@ -23,7 +23,6 @@
 use super::Pipeline;
 use crate::checker::{Checker, StateReport};
 use crate::limits::MAX_NAMES_IN_ERROR;
-use crate::model::MissingJoint;
 use crate::msgs::{CheckTrajectoryResponse, DurationMsg, JointTrajectory, Time, MAX_TRAJECTORY_ENTRIES};
 use std::sync::Arc;
 
@@ -158,28 +157,7 @@ fn joint_indices(robot: &crate::model::RobotModel, names: &[String]) -> Result<V
 /// The positions of the joints a trajectory leaves out (`named[j]` false): the current merged
 /// state, else the missing_joint rule.
 fn left_out_joints(pipeline: &Pipeline, named: &[bool]) -> Result<Vec<f64>, String> {
-    let missing = pipeline.params().missing_joint;
-    let robot = pipeline.checker().robot();
-    let mut base = Vec::with_capacity(robot.joints.len());
-    for (ji, ((joint, current), named)) in robot.joints.iter().zip(pipeline.current_joints()).zip(named).enumerate() {
-        base.push(match current {
-            _ if *named => 0.0,
-            Some(v) => *v,
-            None if joint.is_actuated() && missing == MissingJoint::Reject => {
-                return Err(format!("joint '{}' is neither in joint_names nor in a joint state received so far (missing_joint: reject)", joint.name))
-            }
-            // Under `last` an unknown joint that moves a checked link leaves the robot's pose
-            // unknown: checking it at 0 could call a colliding trajectory free.
-            None if missing == MissingJoint::Last && pipeline.checker().moves_checked_link(ji) => {
-                return Err(format!(
-                    "joint '{}' is neither in joint_names nor in a joint state received so far (missing_joint: last takes it from the joint states)",
-                    joint.name
-                ))
-            }
-            None => 0.0,
-        });
-    }
-    Ok(base)
+    named.iter().enumerate().map(|(j, named)| if *named { Ok(0.0) } else { pipeline.left_out_position(j, "joint_names") }).collect()
 }
 
 /// `t0 + fraction (t1 - t0)` rounded down to the nanosecond (never later than the contact), as a
@@ -265,7 +243,7 @@ fn refused(error: String) -> CheckTrajectoryResponse {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Params;
+    use crate::model::{MissingJoint, Params};
     use crate::msgs::{JointState, JointTrajectoryPoint};
 
     /// The arm with nothing received yet.

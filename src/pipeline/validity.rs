@@ -28,7 +28,7 @@
 use super::Pipeline;
 use crate::checker::{Checker, ObjectType, ReportContact};
 use crate::limits::name_list;
-use crate::model::{MissingJoint, RobotModel};
+use crate::model::RobotModel;
 use crate::msgs::moveit::{ContactInformation, GetStateValidityRequest, GetStateValidityResponse, BODY_ROBOT_LINK, BODY_WORLD_OBJECT};
 use crate::msgs::{Header, Time, Vector3};
 use std::sync::Arc;
@@ -145,26 +145,7 @@ fn resolve(pipeline: &Pipeline, req: &GetStateValidityRequest) -> Result<Vec<f64
         let what = if unknown_count == 1 { "is not a joint" } else { "are not joints" };
         return Err(format!("robot_state.joint_state: {}{more} {what} of the robot model", unknown.join(", ")));
     }
-    let missing = pipeline.params().missing_joint;
-    robot
-        .joints
-        .iter()
-        .zip(given)
-        .zip(pipeline.current_joints())
-        .enumerate()
-        .map(|(ji, ((joint, given), current))| match given.or(*current) {
-            Some(v) => Ok(v),
-            None if joint.is_actuated() && missing == MissingJoint::Reject => {
-                Err(format!("joint '{}' is neither in the request nor in a joint state received so far (missing_joint: reject)", joint.name))
-            }
-            // As for a trajectory: a joint that moves a checked link, known from nowhere.
-            None if missing == MissingJoint::Last && pipeline.checker().moves_checked_link(ji) => Err(format!(
-                "joint '{}' is neither in the request nor in a joint state received so far (missing_joint: last takes it from the joint states)",
-                joint.name
-            )),
-            None => Ok(0.0),
-        })
-        .collect()
+    given.iter().enumerate().map(|(j, given)| given.map_or_else(|| pipeline.left_out_position(j, "the request"), Ok)).collect()
 }
 
 /// The links a group covers (by link index), and a warning for a group the robot does not define.
@@ -272,7 +253,7 @@ fn contact(c: &ReportContact, frame: &str, stamp: Time) -> ContactInformation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Params;
+    use crate::model::{MissingJoint, Params};
     use crate::msgs::moveit::{AttachedCollisionObject, JointConstraint, RobotStateMsg};
     use crate::msgs::{JointState, Transform};
 
