@@ -275,7 +275,8 @@ fn a_long_trajectory_is_checked_while_the_live_stream_goes_on() {
     let points = ((6.0 / per_segment) as usize).min(within_budget).clamp(100, 65_536);
     let waypoints: Vec<Vec<f64>> = (0..points).map(|k| if k % 2 == 0 { a.clone() } else { b.clone() }).collect();
     eprintln!("{points} points, {:.3} ms per segment here", per_segment * 1e3);
-    // The live stream meanwhile: the two states in turn, one every 50 ms until the answer.
+    // The live stream meanwhile: the two states in turn, one every 10 ms until the answer (the
+    // budget-bound request takes 0.3-1.3 s to check on these machines: 30 states or more).
     let stream: Vec<Value> = [&a, &b].iter().map(|q| json!({"name": arm.names, "position": q, "stamp": 10_000_000_000i64})).collect();
 
     let domain = 15 + std::process::id() % 14;
@@ -283,7 +284,7 @@ fn a_long_trajectory_is_checked_while_the_live_stream_goes_on() {
     let answer = common::run_cyclone_peer(
         "trajectory_peer.py",
         &cyclone,
-        &json!({"domain": domain, "long": request_of(&arm.names, &waypoints), "stream": stream, "timeout": 120}).to_string(),
+        &json!({"domain": domain, "long": request_of(&arm.names, &waypoints), "stream": stream, "period": 0.01, "timeout": 120}).to_string(),
     );
     let _ = common::stop_node(node);
     let long = &answer["long"];
@@ -291,8 +292,8 @@ fn a_long_trajectory_is_checked_while_the_live_stream_goes_on() {
     assert_eq!((&long["answer"]["valid"], &long["answer"]["segment"]), (&json!(true), &json!(-1)), "{long}");
     let seconds = long["seconds"].as_f64().unwrap();
     // The request is sized by the sub-interval budget (it must be answered valid), which bounds
-    // its length to about 1.3 s of checking here: at least 0.5 s (ten states of the stream) keeps the test meaningful.
-    assert!(seconds >= 0.5, "the check must take a while for this test to mean anything ({seconds} s)");
+    // its length to 0.3-1.3 s of checking here: at least 0.1 s (ten states of the stream) keeps the test meaningful.
+    assert!(seconds >= 0.1, "the check must take a while for this test to mean anything ({seconds} s)");
     // Reports kept coming while the trajectory was checked.
     let before = long["reports_before_answer"].as_u64().unwrap();
     let sent = long["states_sent"].as_u64().unwrap();

@@ -5,7 +5,7 @@ Loopback only: the caller sets CYCLONEDDS_URI (127.0.0.1, no multicast, peer 127
 
 stdin: {"domain": id, "state": {"name", "position", "stamp"} (published first, until the node
         reports on it), "trajectories": [T...], "long": T (optional), "stream": [states sent in turn,
-        every 50 ms, while the long one is checked], "timeout": s}
+        every "period" s (default 0.05), while the long one is checked], "timeout": s}
         T = {"joint_names": [...], "points": [{"positions": [...], "t": ns}]}; a position may be
         the string "NaN".
 stdout: {"state_report": report or null, "answers": [A...], "long": {"answer": A, "seconds": s,
@@ -112,15 +112,16 @@ if req.get("long"):
     t0 = time.time()
     answer, answered_at, arrivals, latencies, sent_at = None, None, [], [], {}
     stream = req.get("stream", [])
+    period = float(req.get("period", 0.05))
     i = 0
     while time.time() < end and answer is None:
         if stream:
-            # Cycled, stamped 50 ms apart from the first one's stamp.
-            st = dict(stream[i % len(stream)], stamp=int(stream[0]["stamp"]) + 50_000_000 * i)
+            # Cycled, stamped `period` apart from the first one's stamp.
+            st = dict(stream[i % len(stream)], stamp=int(stream[0]["stamp"]) + int(period * 1e9) * i)
             sent_at[st["stamp"]] = time.time()
             states_w.write(js(st))
             i += 1
-        stop = time.time() + 0.05
+        stop = time.time() + period
         while time.time() < stop and answer is None:
             for r in reports_r.take(N=100):
                 now = time.time()
