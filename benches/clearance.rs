@@ -10,7 +10,6 @@
 mod peer_compare_core;
 
 use peer_compare_core::*;
-use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 use thickness_collision::checker::Checker;
@@ -19,12 +18,6 @@ use thickness_collision::math::Pose;
 use thickness_collision::model::Params;
 
 const THRESHOLD: f64 = 0.05;
-
-fn write_raw<T: Copy>(path: &Path, data: &[T]) {
-    // Plain little-endian arrays (this machine is little endian, as the reader assumes).
-    let bytes = unsafe { std::slice::from_raw_parts(data.as_ptr() as *const u8, std::mem::size_of_val(data)) };
-    std::fs::write(path, bytes).unwrap();
-}
 
 fn main() {
     if std::env::args().any(|a| a == "--test" || a == "--list") {
@@ -40,8 +33,8 @@ fn main() {
 
     let w = world(size);
     let triangles = w.triangles.len();
-    write_raw(&dir.join("env_vertices.f64"), &w.vertices);
-    write_raw(&dir.join("env_triangles.u32"), &w.triangles);
+    scaffold::write_le(&dir.join("env_vertices.f64"), &w.vertices);
+    scaffold::write_le(&dir.join("env_triangles.u32"), &w.triangles);
     let params = Params { package_map: map.clone(), clearance_threshold: THRESHOLD, ..Params::default() };
     let checker = Checker::from_robot_and_scene(params.clone(), robot.clone(), w.scene, "panda".into()).unwrap();
     // The same world built again for the check without clearance (the scene is not shared).
@@ -78,8 +71,8 @@ fn main() {
     }
     for (i, (_, hull, _)) in parts.iter().enumerate() {
         let (pts, tri) = hull.vertices_and_triangles();
-        write_raw(&dir.join(format!("part{i}_vertices.f64")), &pts);
-        write_raw(&dir.join(format!("part{i}_triangles.u32")), &tri);
+        scaffold::write_le(&dir.join(format!("part{i}_vertices.f64")), &pts);
+        scaffold::write_le(&dir.join(format!("part{i}_triangles.u32")), &tri);
     }
     let mut poses: Vec<f64> = Vec::with_capacity(states.len() * parts.len() * 12);
     for (names, pos) in &states {
@@ -93,7 +86,7 @@ fn main() {
             poses.extend_from_slice(&thickness_collision::math::pose_rows(&p));
         }
     }
-    write_raw(&dir.join("poses.f64"), &poses);
+    scaffold::write_le(&dir.join("poses.f64"), &poses);
     std::fs::write(dir.join("meta.json"), serde_json::json!({"states": states.len(), "parts": parts.len()}).to_string()).unwrap();
     let script = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("benches/clearance_coal.py");
     let out = Command::new(&py).arg(&script).arg(&dir).output().unwrap();

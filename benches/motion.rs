@@ -31,12 +31,6 @@ fn env_usize(name: &str, default: usize) -> usize {
     std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
 }
 
-fn write_raw<T: Copy>(path: &Path, data: &[T]) {
-    // Plain little-endian arrays of f64 / u32, as benches/peer_compare_core.rs writes them.
-    let bytes = unsafe { std::slice::from_raw_parts(data.as_ptr() as *const u8, std::mem::size_of_val(data)) };
-    std::fs::write(path, bytes).unwrap();
-}
-
 /// Joint positions at `s` along a motion.
 type Along<'a> = &'a dyn Fn(&[f64], &[f64], f64) -> Vec<f64>;
 /// Dense samples for a motion.
@@ -185,12 +179,12 @@ fn coal_moveit(
             }
         }
     }
-    write_raw(&dir.join("env_vertices.f64"), world_vertices);
-    write_raw(&dir.join("env_triangles.u32"), world_triangles);
+    peer_compare_core::scaffold::write_le(&dir.join("env_vertices.f64"), world_vertices);
+    peer_compare_core::scaffold::write_le(&dir.join("env_triangles.u32"), world_triangles);
     for (i, (_, hull, _)) in parts.iter().enumerate() {
         let (pts, tri) = hull.vertices_and_triangles();
-        write_raw(&dir.join(format!("part{i}_vertices.f64")), &pts);
-        write_raw(&dir.join(format!("part{i}_triangles.u32")), &tri);
+        peer_compare_core::scaffold::write_le(&dir.join(format!("part{i}_vertices.f64")), &pts);
+        peer_compare_core::scaffold::write_le(&dir.join(format!("part{i}_triangles.u32")), &tri);
     }
     let robot = checker.robot();
     let mut poses: Vec<f64> = Vec::with_capacity(pairs.len() * MOVEIT_STATES * parts.len() * 12);
@@ -203,7 +197,7 @@ fn coal_moveit(
             }
         }
     }
-    write_raw(&dir.join("motion_poses.f64"), &poses);
+    peer_compare_core::scaffold::write_le(&dir.join("motion_poses.f64"), &poses);
     let meta = serde_json::json!({"motions": pairs.len(), "samples": MOVEIT_STATES, "parts": parts.len()});
     std::fs::write(dir.join("meta.json"), meta.to_string()).unwrap();
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("benches/coal_motion.py");

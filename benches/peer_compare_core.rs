@@ -2,6 +2,10 @@
 //! full run) and `tests/peer_agreement.rs` (a small version in the test suite).
 #![allow(dead_code)]
 
+/// The tests' scaffolding (scratch folders, the little-endian writer for the peers, mesh to area).
+#[path = "../tests/common/scaffold.rs"]
+pub mod scaffold;
+
 use oorandom::Rand64;
 use parry3d_f64::shape::ConvexPolyhedron;
 use serde_json::Value;
@@ -12,10 +16,8 @@ use std::time::Instant;
 use thickness_collision::checker::Checker;
 use thickness_collision::collision::{Scene, TargetShape};
 use thickness_collision::math::{Pose, Real};
-use thickness_collision::mesh::{MeshTopology, TopologySettings};
 use thickness_collision::model::example_workcell::peer_environment;
 use thickness_collision::model::{PackageResolver, Params, RobotModel};
-use thickness_collision::thickness::{ThicknessArea, ThicknessSettings};
 
 pub const THICKNESS: Real = 0.02;
 
@@ -72,8 +74,7 @@ pub fn world(triangles: usize) -> World {
     let mut tris = Vec::new();
     let started = Instant::now();
     for (name, (v, t), pose) in peer_environment(triangles) {
-        let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).unwrap();
-        let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: THICKNESS, ..Default::default() }).unwrap();
+        let area = scaffold::thin_area(&v, &t, THICKNESS);
         let _ = scene.add_surface(name, pose, area);
         let base = vertices.len() as u32;
         vertices.extend(v.iter().map(|p| (pose * *p).to_array()));
@@ -86,12 +87,6 @@ pub fn world(triangles: usize) -> World {
         .map(|o| o.bvh_memory() + o.area().map_or(0, |a| a.cells.len() * std::mem::size_of::<thickness_collision::thickness::ThicknessCell>()))
         .sum();
     World { scene, vertices, triangles: tris, build_seconds, memory_bytes }
-}
-
-fn write_raw<T: Copy>(path: &Path, data: &[T]) {
-    // Plain little-endian arrays of f64 / u32 (this machine is little endian, as the reader assumes).
-    let bytes = unsafe { std::slice::from_raw_parts(data.as_ptr() as *const u8, std::mem::size_of_val(data)) };
-    std::fs::write(path, bytes).unwrap();
 }
 
 /// The result of one world.
@@ -156,12 +151,12 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
         }
     }
     std::fs::create_dir_all(dir).unwrap();
-    write_raw(&dir.join("env_vertices.f64"), &w.vertices);
-    write_raw(&dir.join("env_triangles.u32"), &w.triangles);
+    scaffold::write_le(&dir.join("env_vertices.f64"), &w.vertices);
+    scaffold::write_le(&dir.join("env_triangles.u32"), &w.triangles);
     for (i, (_, hull, _)) in parts.iter().enumerate() {
         let (pts, tri) = hull.vertices_and_triangles();
-        write_raw(&dir.join(format!("part{i}_vertices.f64")), &pts);
-        write_raw(&dir.join(format!("part{i}_triangles.u32")), &tri);
+        scaffold::write_le(&dir.join(format!("part{i}_vertices.f64")), &pts);
+        scaffold::write_le(&dir.join(format!("part{i}_triangles.u32")), &tri);
     }
     let mut poses: Vec<f64> = Vec::with_capacity(states.len() * parts.len() * 12);
     let mut link_poses = Vec::with_capacity(states.len());
@@ -183,7 +178,7 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
         }
         link_poses.push(world_links);
     }
-    write_raw(&dir.join("poses.f64"), &poses);
+    scaffold::write_le(&dir.join("poses.f64"), &poses);
     let meta = serde_json::json!({"states": states.len(), "parts": parts.len()});
     std::fs::File::create(dir.join("meta.json")).unwrap().write_all(meta.to_string().as_bytes()).unwrap();
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("benches/peer_compare.py");

@@ -6,6 +6,10 @@
 
 #[path = "wall_1m.rs"]
 mod wall_1m;
+// Only the mesh-to-area helper: the rest of the tests' scaffolding is unused here.
+#[allow(dead_code)]
+#[path = "../tests/common/scaffold.rs"]
+mod scaffold;
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use parry3d_f64::query;
@@ -14,8 +18,6 @@ use std::sync::Arc;
 use std::time::Duration;
 use thickness_collision::collision::{CollideSettings, ConvexHull, Scene, Target, TargetShape};
 use thickness_collision::math::{Pose, Real, Rotation, Vector};
-use thickness_collision::mesh::{MeshTopology, TopologySettings};
-use thickness_collision::thickness::{ThicknessArea, ThicknessSettings};
 use wall_1m::{wall, AMPLITUDE, WAVELENGTH};
 
 /// ~200 faces: 102 points on an elongated ellipsoid the size of a Panda link (8 x 8 x 16 cm).
@@ -39,8 +41,7 @@ fn wall_height(x: Real, y: Real) -> Real {
 fn bench_query(c: &mut Criterion) {
     // 708 x 708 quads = 1,002,528 triangles over 7 x 7 m (about 1 cm triangles).
     let (v, t) = wall(708, 708);
-    let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).expect("mesh");
-    let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: 0.02, ..Default::default() }).expect("cells");
+    let area = scaffold::thin_area(&v, &t, 0.02);
     let mut scene = Scene::new();
     let _ = scene.add_surface("wall", Pose::IDENTITY, area);
     let hull = Arc::new(panda_sized_hull());

@@ -5,6 +5,10 @@
 
 #[path = "common/joint_state_bag.rs"]
 mod joint_state_bag;
+// Only the scratch folder: the rest of the tests' scaffolding is unused here.
+#[allow(dead_code)]
+#[path = "../tests/common/scaffold.rs"]
+mod scaffold;
 
 use joint_state_bag::write_joint_state_bag;
 use oorandom::Rand64;
@@ -32,8 +36,7 @@ fn main() {
             (names, pos)
         })
         .collect();
-    let root = std::env::temp_dir().join(format!("tc_bench_replay_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = scaffold::emptied(scaffold::scratch_dir("bench_replay"));
     let bag = root.join("in");
     let _ = write_joint_state_bag(&bag, "bench", 1_000_000, states);
     let size = std::fs::metadata(bag.join("bench_0.mcap")).unwrap().len();

@@ -11,6 +11,10 @@
 
 #[path = "common/joint_state_bag.rs"]
 mod joint_state_bag;
+// Only the scratch folder: the rest of the tests' scaffolding is unused here.
+#[allow(dead_code)]
+#[path = "../tests/common/scaffold.rs"]
+mod scaffold;
 
 use joint_state_bag::write_joint_state_bag;
 use oorandom::Rand64;
@@ -71,8 +75,7 @@ fn main() {
     let rounds: usize = std::env::var("ROUNDS").ok().and_then(|v| v.parse().ok()).unwrap_or(3);
     let bags = std::env::var("BAGS").unwrap_or_default();
     let checker = Checker::from_params(Params::default()).unwrap();
-    let root = std::env::temp_dir().join(format!("tc_bench_replay_view_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = scaffold::emptied(scaffold::scratch_dir("bench_replay_view"));
     if bags != "sweep" {
         scenario(&root, &checker, false, rounds);
     }

@@ -17,12 +17,6 @@ use thickness_collision::checker::Checker;
 use thickness_collision::collision::{Scene, TargetShape};
 use thickness_collision::model::Params;
 
-fn write_raw<T: Copy>(path: &Path, data: &[T]) {
-    // Plain little-endian arrays (this machine is little endian, as the reader assumes).
-    let bytes = unsafe { std::slice::from_raw_parts(data.as_ptr() as *const u8, std::mem::size_of_val(data)) };
-    std::fs::write(path, bytes).unwrap();
-}
-
 fn main() {
     let n: usize = std::env::var("STATES").ok().and_then(|v| v.parse().ok()).unwrap_or(10_000);
     let py = peer_compare_core::python();
@@ -53,16 +47,14 @@ fn main() {
     let ours = started.elapsed().as_secs_f64();
 
     // The same hulls and part poses for coal.
-    let dir = std::env::temp_dir().join(format!("tc_bench_self_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = peer_compare_core::scaffold::emptied(peer_compare_core::scaffold::scratch_dir("bench_self"));
     let mut parts = Vec::new();
     for (ti, t) in targets.iter().enumerate() {
         for (pi, (shape, _)) in t.parts.iter().enumerate() {
             let TargetShape::Polytope(hull) = shape else { panic!("Panda links are meshes") };
             let (pts, tri) = hull.vertices_and_triangles();
-            write_raw(&dir.join(format!("part{}_vertices.f64", parts.len())), &pts);
-            write_raw(&dir.join(format!("part{}_triangles.u32", parts.len())), &tri);
+            peer_compare_core::scaffold::write_le(&dir.join(format!("part{}_vertices.f64", parts.len())), &pts);
+            peer_compare_core::scaffold::write_le(&dir.join(format!("part{}_triangles.u32", parts.len())), &tri);
             parts.push((ti, pi));
         }
     }
@@ -82,8 +74,8 @@ fn main() {
             poses.extend_from_slice(&thickness_collision::math::pose_rows(&p));
         }
     }
-    write_raw(&dir.join("poses.f64"), &poses);
-    write_raw(&dir.join("pairs.u32"), &part_pairs);
+    peer_compare_core::scaffold::write_le(&dir.join("poses.f64"), &poses);
+    peer_compare_core::scaffold::write_le(&dir.join("pairs.u32"), &part_pairs);
     std::fs::write(dir.join("meta.json"), serde_json::json!({"states": n, "parts": parts.len()}).to_string()).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/self_collision_coal.py");
     let out = Command::new(&py).arg(&script).arg(&dir).output().unwrap();

@@ -11,12 +11,14 @@
 //! - `flag_only` giving the same verdict, on a cell that collides, with or without the least
 //!   overlap (without it, a cell can be accepted by the centroid test alone).
 
+mod common;
+
 use oorandom::Rand64;
 use std::sync::Arc;
 use thickness_collision::collision::{collide_target_cell, CollideSettings, ConvexHull, Scene, Target, TargetShape};
 use thickness_collision::math::{Pose, Real, Rotation, Vector};
-use thickness_collision::mesh::{generate, MeshTopology, TopologySettings};
-use thickness_collision::thickness::{Side, ThicknessArea, ThicknessCell, ThicknessSettings};
+use thickness_collision::mesh::generate;
+use thickness_collision::thickness::{Side, ThicknessCell, ThicknessSettings};
 
 struct Rng(Rand64);
 
@@ -82,9 +84,9 @@ fn pruned_queries_agree_with_brute_force() {
     let mut rng = Rng(Rand64::new(2026));
     let (mut queries, mut colliding, mut deep_cells) = (0, 0, 0usize);
     for (name, (v, t)) in surfaces() {
-        let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).unwrap();
+        let mesh = common::topology(&v, &t);
         for side in [Side::Back, Side::Front, Side::Both] {
-            let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: 0.02, side, ..Default::default() }).unwrap();
+            let area = common::topology_area(&mesh, &ThicknessSettings { thickness: 0.02, side, ..Default::default() });
             // The surface placed somewhere in the world, so that frames are exercised too.
             let pose = Pose::from_parts(Vector::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)), rng.rotation());
             let mut scene = Scene::new();

@@ -1,9 +1,10 @@
 //! The bundled example meshes are the generated ones, and they load through the file reader with
 //! the expected topology.
 
+mod common;
+
 use std::path::PathBuf;
 use thickness_collision::math::Vector;
-use thickness_collision::mesh::{MeshTopology, TopologySettings};
 use thickness_collision::model::example_workcell::example_meshes;
 use thickness_collision::model::mesh_file::{read_mesh, write_obj};
 
@@ -19,7 +20,7 @@ fn example_meshes_are_current_and_open() {
         }
         let data = read_mesh(&path, Vector::ONE).unwrap_or_else(|e| panic!("{e} (regenerate with UPDATE_EXAMPLES=1)"));
         assert_eq!(data.triangles.len(), t.len(), "{name} is stale: run UPDATE_EXAMPLES=1 cargo test --test example_workcell");
-        let mesh = MeshTopology::build(&data.vertices, &data.triangles, &TopologySettings::default()).unwrap();
+        let mesh = common::topology(&data.vertices, &data.triangles);
         assert_eq!(mesh.report.degenerate_triangles + mesh.report.duplicate_triangles, 0, "{name}");
         assert_eq!(mesh.report.boundary_edges > 0, open, "{name}: open (thin) surface or closed");
         assert_eq!(mesh.report.non_manifold_edges + mesh.report.inconsistent_edges, 0, "{name}");

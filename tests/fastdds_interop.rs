@@ -36,7 +36,7 @@ fn state_json(k: usize, stamp: i64) -> Value {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    common::scratch_dir(&format!("fastdds_{name}"))
+    common::scratch_subdir("fastdds_interop", name)
 }
 
 /// `check --states FILE --json` (plus `extra`) on JSON lines; one report per line.

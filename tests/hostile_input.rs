@@ -40,8 +40,11 @@ fn run(args: &[&str]) -> Run {
         .spawn()
         .unwrap();
     let mut status = 0;
+    // SAFETY: `rusage` is plain integers, for which all-zero bytes are a valid value.
     let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
     let pid = child.id() as libc::pid_t;
+    // SAFETY: wait4 on our own child's pid (the Child handle is never waited on), writing through
+    // two pointers to live locals of the types it expects.
     assert_eq!(unsafe { libc::wait4(pid, &mut status, 0, &mut usage) }, pid);
     let code = libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status));
     let run =
@@ -78,6 +81,7 @@ fn mkfifo(name: &str) -> PathBuf {
     let p = scratch().join(name);
     let _ = std::fs::remove_file(&p);
     let c = std::ffi::CString::new(p.to_str().unwrap()).unwrap();
+    // SAFETY: `c` is a NUL-terminated path that outlives the call, which only reads it.
     assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
     p
 }

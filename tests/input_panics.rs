@@ -1,5 +1,7 @@
 //! Issue 11, item 5: inputs that used to reach a panic now get a clear error naming them.
 
+mod common;
+
 use std::process::Command;
 use thickness_collision::checker::{Checker, CheckerError};
 use thickness_collision::model::{bundled_config_dir, PackageResolver, Params, PositionsError, RobotModel};
@@ -47,8 +49,7 @@ fn issue_11_forward_kinematics_checks_its_positions() {
 
 #[test]
 fn issue_11_a_tiny_marker_rate_is_refused_not_a_panic() {
-    let dir = std::env::temp_dir().join(format!("tc_input_panics_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("input_panics");
     let params = dir.join("rate.yaml");
     std::fs::write(&params, "thickness_collision:\n  ros__parameters:\n    marker_rate: 1.0e-300\n").unwrap();
     let out = bin().args(["check", "--params-file", params.to_str().unwrap(), "--joints", "elbow_joint=0"]).output().unwrap();

@@ -134,8 +134,7 @@ fn a_rotating_link_leaving_the_hull_of_its_end_poses_is_caught() {
 /// `check --states --motion`: the first line is a state, each further line the motion to it.
 #[test]
 fn check_motion_on_the_command_line() {
-    let dir = std::env::temp_dir().join(format!("tc_motion_cases_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("motion_cases");
     let states = dir.join("path.jsonl");
     let line = |lift: f64, elbow: f64| format!("{{\"name\": [\"shoulder_lift_joint\", \"elbow_joint\"], \"position\": [{lift}, {elbow}]}}\n");
     // The first waypoint is the whole arm (missing_joint: last waits for every joint); the others

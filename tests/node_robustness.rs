@@ -106,9 +106,7 @@ fn count(status: &Value, key: &str) -> u64 {
 #[test]
 fn hostile_input_does_not_take_the_node_down() {
     let started = Instant::now();
-    let dir = std::env::temp_dir().join(format!("tc_node_robustness_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::emptied(common::scratch_dir("node_robustness"));
     let cyclone = dir.join("cyclone.xml");
     std::fs::write(&cyclone, CYCLONE_LOOPBACK).unwrap();
     // Domains 30-69: the other DDS tests use 100-229.

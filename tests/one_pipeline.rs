@@ -27,10 +27,7 @@ fn bin() -> Command {
 }
 
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tc_one_pipeline_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::emptied(common::scratch_subdir("one_pipeline", name))
 }
 
 /// Arm positions that sweep the bundled arm through the workcell (some colliding, some not).

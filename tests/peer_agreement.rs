@@ -14,7 +14,7 @@ fn no_unexplained_disagreement_with_coal_and_fcl() {
     let py = python();
     let (robot, map) = panda(&py);
     let states = random_states(&robot, 300, 1);
-    let dir = std::env::temp_dir().join(format!("tc_peer_agreement_{}", std::process::id()));
+    let dir = scaffold::scratch_dir("peer_agreement");
     let c = compare(&py, &robot, &map, &states, 10_000, &dir);
     eprintln!(
         "{} triangles, {} states: ours colliding {}, coal {}; explained by thickness {}, by touching {}; unexplained {}",

@@ -18,10 +18,7 @@ fn bin() -> Command {
 }
 
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tc_real_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::emptied(common::scratch_subdir("real_inputs", name))
 }
 
 fn fixture(name: &str) -> PathBuf {

@@ -16,10 +16,7 @@ fn bin() -> Command {
 }
 
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tc_replay_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::emptied(common::scratch_subdir("replay_bags", name))
 }
 
 fn ok(out: Output) -> String {

@@ -23,10 +23,7 @@ fn bin() -> Command {
 }
 
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tc_view_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::emptied(common::scratch_subdir("replay_view", name))
 }
 
 fn ok(c: &mut Command) -> String {

@@ -22,8 +22,7 @@ fn state(k: usize) -> (Vec<&'static str>, Vec<f64>) {
 
 #[test]
 fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
-    let dir = std::env::temp_dir().join(format!("tc_ros_node_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_subdir("ros_node", "states");
     let cyclone = common::cyclone_loopback_file(&dir);
     let domain = 100 + std::process::id() % 50;
     let params = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/params.yaml");
@@ -159,8 +158,7 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
     use thickness_collision::checker::Checker;
     use thickness_collision::math::pose_from_isometry;
     use thickness_collision::model::Params;
-    let dir = std::env::temp_dir().join(format!("tc_ros_node_tf_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_subdir("ros_node", "tf");
     let cyclone = common::cyclone_loopback_file(&dir);
     let domain = 150 + std::process::id() % 50;
     let (mut node, _out, banner) = start_node(
@@ -241,8 +239,7 @@ fn tf_input_with_a_frame_prefix_equals_check_with_transforms() {
 
 #[test]
 fn robot_description_topic_replaces_the_robot_and_a_bad_one_is_refused() {
-    let dir = std::env::temp_dir().join(format!("tc_ros_node_desc_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_subdir("ros_node", "desc");
     let cyclone = common::cyclone_loopback_file(&dir);
     let domain = 200 + std::process::id() % 30;
     let urdf = common::fat_arm_urdf();

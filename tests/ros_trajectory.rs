@@ -17,7 +17,7 @@ use thickness_collision::checker::Checker;
 use thickness_collision::model::{JointKind, Params};
 
 fn scratch(name: &str) -> (PathBuf, PathBuf) {
-    let dir = common::scratch_dir(&format!("ros_trajectory_{name}"));
+    let dir = common::scratch_subdir("ros_trajectory", name);
     let cyclone = common::cyclone_loopback_file(&dir);
     (dir, cyclone)
 }

@@ -41,8 +41,7 @@ fn assert_same(k: usize, got: &Value, cli: &Value) {
 
 #[test]
 fn check_state_validity_agrees_with_check_and_refuses_what_it_cannot_honour() {
-    let dir = std::env::temp_dir().join(format!("tc_ros_validity_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("ros_validity");
     let cyclone = common::cyclone_loopback_file(&dir);
 
     // Random states of the bundled arm within its limits, some free and some not.

@@ -10,6 +10,8 @@
 //!   parry's support map, and is positive;
 //! - the result does not change under a common random rigid motion of target and cell.
 
+mod common;
+
 use oorandom::Rand64;
 use parry3d_f64::query;
 use parry3d_f64::query::PointQuery;
@@ -17,8 +19,8 @@ use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, Cylinder, Shape};
 use std::sync::Arc;
 use thickness_collision::collision::{collide_target_cell, ConvexHull, Target, TargetShape};
 use thickness_collision::math::{Pose, Real, Rotation, Vector};
-use thickness_collision::mesh::{generate, MeshTopology, TopologySettings};
-use thickness_collision::thickness::{CellKind, Side, ThicknessArea, ThicknessCell, ThicknessSettings};
+use thickness_collision::mesh::generate;
+use thickness_collision::thickness::{CellKind, Side, ThicknessCell, ThicknessSettings};
 
 const PAIRS: usize = 100_000;
 const BAND: Real = 1e-6;
@@ -54,9 +56,9 @@ fn cell_pool() -> Vec<(ThicknessCell, Side)> {
         (generate::saddle(6, 0.3, 2.0), 0.02),
     ];
     for ((v, t), thickness) in meshes {
-        let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).unwrap();
+        let mesh = common::topology(&v, &t);
         for side in [Side::Back, Side::Front, Side::Both] {
-            let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() }).unwrap();
+            let area = common::topology_area(&mesh, &ThicknessSettings { thickness, side, ..Default::default() });
             pool.extend(area.cells.into_iter().map(|c| (c, side)));
         }
     }

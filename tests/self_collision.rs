@@ -51,9 +51,7 @@ fn compare(name: &str, urdf: &str, srdf: &str, n: usize, seed: u64) -> Outcome {
             }
         }
     }
-    let dir = std::env::temp_dir().join(format!("tc_self_collision_{name}_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::emptied(common::scratch_subdir("self_collision", name));
     let mut kinds = Vec::new();
     for (k, &(ti, pi)) in parts.iter().enumerate() {
         let hull = match &targets[ti].parts[pi].0 {

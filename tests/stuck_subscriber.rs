@@ -91,8 +91,7 @@ fn spawn_stuck(cyclone: &std::path::Path, domain: u32) -> Stuck {
 
 #[test]
 fn a_stopped_reliable_subscriber_does_not_stall_collisions() {
-    let dir = std::env::temp_dir().join(format!("tc_stuck_subscriber_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("stuck_subscriber");
     let cyclone = common::cyclone_loopback_file(&dir);
     let long_lease = dir.join("cyclone_long_lease.xml");
     std::fs::write(&long_lease, CYCLONE_LOOPBACK.replace("<Discovery>", "<Discovery><LeaseDuration>60 s</LeaseDuration>")).unwrap();

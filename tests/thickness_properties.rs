@@ -37,6 +37,7 @@
 //! triangles. Every violation is counted and printed per mesh (nothing is hidden), and the volume
 //! the near-vertex mismatch occupies is measured separately.
 
+mod common;
 mod shapes;
 
 use oorandom::Rand64;
@@ -47,7 +48,7 @@ use std::f64::consts::PI;
 use std::time::Instant;
 use thickness_collision::math::{Aabb, Pose, Real, Rotation, Vector};
 use thickness_collision::mesh::generate::{self, Soup};
-use thickness_collision::mesh::{EdgeLink, MeshTopology, TopologySettings};
+use thickness_collision::mesh::{EdgeLink, MeshTopology};
 use thickness_collision::thickness::{is_collapsed, CellKind, Side, ThicknessArea, ThicknessCell, ThicknessSettings, WallRule};
 
 /// Sampled points per mesh and property.
@@ -310,8 +311,8 @@ struct Probe {
 }
 
 fn build_probe(soup: &Soup, t: Real, side: Side, walls: WallRule) -> Probe {
-    let mesh = MeshTopology::build(&soup.0, &soup.1, &TopologySettings::default()).expect("mesh");
-    let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: t, side, walls, ..Default::default() }).expect("cells");
+    let mesh = common::topology(&soup.0, &soup.1);
+    let area = common::topology_area(&mesh, &ThicknessSettings { thickness: t, side, walls, ..Default::default() });
     assert_eq!(area.cells.len(), mesh.triangles.len(), "every face of these meshes gets a cell");
     for (f, cell) in area.cells.iter().enumerate() {
         assert_eq!(cell.triangle, mesh.source_triangle[f]);
@@ -1206,7 +1207,7 @@ fn topology_reports_winding_and_edges() {
                 assert_eq!(p.mesh.report.flipped_faces, 0, "{}: generated outward", case.name);
                 // Inverted input: every face flipped back to outward.
                 let inverted: Vec<[u32; 3]> = soup.1.iter().map(|t| [t[0], t[2], t[1]]).collect();
-                let m = MeshTopology::build(&soup.0, &inverted, &TopologySettings::default()).unwrap();
+                let m = common::topology(&soup.0, &inverted);
                 assert_eq!(m.report.flipped_faces, soup.1.len());
                 for (a, b) in m.normals.iter().zip(&p.mesh.normals) {
                     assert!(a.distance(*b) < 1e-12);

@@ -13,6 +13,7 @@
 //! - the gap and overlap volume fractions near vertices, measured and printed;
 //! - shared walls vs. naive per-triangle prisms on V-folds: the reason the method exists.
 
+mod common;
 mod shapes;
 
 use oorandom::Rand64;
@@ -22,7 +23,7 @@ use shapes::{aabb_of, fan_fold, segment_crosses_triangle};
 use std::f64::consts::PI;
 use thickness_collision::math::{Pose, Real, Rotation, Vector};
 use thickness_collision::mesh::generate::{self, Soup};
-use thickness_collision::mesh::{EdgeLink, MeshTopology, TopologySettings};
+use thickness_collision::mesh::{EdgeLink, MeshTopology};
 use thickness_collision::thickness::{CellKind, Side, ThicknessArea, ThicknessSettings, WallRule};
 
 const POINTS: usize = 10_000;
@@ -144,8 +145,8 @@ struct Built {
 }
 
 fn build(soup: &Soup, t: Real, side: Side, walls: WallRule) -> Built {
-    let mesh = MeshTopology::build(&soup.0, &soup.1, &TopologySettings::default()).unwrap();
-    let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness: t, side, walls, ..Default::default() }).unwrap();
+    let mesh = common::topology(&soup.0, &soup.1);
+    let area = common::topology_area(&mesh, &ThicknessSettings { thickness: t, side, walls, ..Default::default() });
     assert_eq!(area.cells.len(), mesh.triangles.len(), "every face gets a cell here");
     let cell_bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &area.cells.iter().map(|c| aabb_of(&c.vertices())).collect::<Vec<_>>());
     let tri_bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &(0..mesh.triangles.len()).map(|f| aabb_of(&mesh.corners(f))).collect::<Vec<_>>());
@@ -484,10 +485,10 @@ fn wrong_winding_gives_the_same_cells_as_the_right_one() {
     let mut bad = t.clone();
     bad[17].swap(0, 1);
     let settings = ThicknessSettings { thickness: 0.02, ..Default::default() };
-    let good_area = ThicknessArea::build(&MeshTopology::build(&v, &t, &TopologySettings::default()).unwrap(), &settings).unwrap();
-    let bad_mesh = MeshTopology::build(&v, &bad, &TopologySettings::default()).unwrap();
+    let good_area = common::mesh_area(&v, &t, &settings);
+    let bad_mesh = common::topology(&v, &bad);
     assert_eq!(bad_mesh.report.flipped_faces, 1);
-    let bad_area = ThicknessArea::build(&bad_mesh, &settings).unwrap();
+    let bad_area = common::topology_area(&bad_mesh, &settings);
     for (a, b) in good_area.cells.iter().zip(&bad_area.cells) {
         let (sa, sb) = (a.distinct_vertices(), b.distinct_vertices());
         assert_eq!(sa.len(), sb.len());
@@ -500,8 +501,8 @@ fn wrong_winding_gives_the_same_cells_as_the_right_one() {
 #[test]
 fn front_and_both_mirror_back() {
     let (v, t) = generate::wavy_sheet(10, 10, 1.0, 1.0, 0.05, 0.5);
-    let mesh = MeshTopology::build(&v, &t, &TopologySettings::default()).unwrap();
-    let cells = |side| ThicknessArea::build(&mesh, &ThicknessSettings { thickness: 0.02, side, ..Default::default() }).unwrap().cells;
+    let mesh = common::topology(&v, &t);
+    let cells = |side| common::topology_area(&mesh, &ThicknessSettings { thickness: 0.02, side, ..Default::default() }).cells;
     let (back, front, both) = (cells(Side::Back), cells(Side::Front), cells(Side::Both));
     let mut rng = Rand64::new(11);
     for ((b, f), o) in back.iter().zip(&front).zip(&both) {

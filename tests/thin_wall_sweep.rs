@@ -20,8 +20,7 @@ fn a_link_behind_the_wall_is_caught_where_coal_misses_it() {
     let erd = common::example_robot_data();
     let panda = erd.join("robots/panda_description/urdf/panda.urdf");
     let hand_stl = erd.join("robots/panda_description/meshes/collision/hand.stl");
-    let dir = std::env::temp_dir().join(format!("tc_sweep_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("thin_wall_sweep");
 
     // The wall: a flat 1 x 1 m sheet of 800 triangles standing at x = 0.5, front towards -x.
     let (wv, wt) = generate::flat_grid(20, 20, 1.0, 1.0);

@@ -13,7 +13,7 @@ mod scaffold;
 
 // Each test binary uses some of these.
 #[allow(unused_imports)]
-pub use self::scaffold::{mesh_area, scratch_dir, thin_area, topology, write_le, LeBytes};
+pub use self::scaffold::{emptied, mesh_area, scratch_dir, scratch_subdir, thin_area, topology, topology_area, write_le, LeBytes};
 
 /// A Cyclone DDS configuration that keeps a peer on loopback: `NetworkInterface 127.0.0.1`, no
 /// multicast, the peer 127.0.0.1 (the network rule in the design notes).

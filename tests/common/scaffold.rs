@@ -1,5 +1,6 @@
-//! Scaffolding every kind of test uses: a scratch folder per test file, raw little-endian arrays
-//! for the Python peers, and a thickness area straight from a triangle soup.
+//! Scaffolding every kind of test uses: a scratch folder per test file (and one per test inside
+//! it), raw little-endian arrays for the Python peers, and a thickness area straight from a
+//! triangle soup. The benches include this file too (`#[path]`).
 
 use std::path::{Path, PathBuf};
 use thickness_collision::math::{Real, Vector};
@@ -9,7 +10,26 @@ use thickness_collision::thickness::{ThicknessArea, ThicknessSettings};
 /// `<temp>/tc_<name>_<pid>`, created: the scratch folder of one test binary (the process id keeps
 /// two runs at a time apart; `name` keeps the test files apart).
 pub fn scratch_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tc_{name}_{}", std::process::id()));
+    created(std::env::temp_dir().join(format!("tc_{name}_{}", std::process::id())))
+}
+
+/// `<scratch_dir(file)>/<name>`, created: one test's own folder, so that the tests of one file,
+/// which run in parallel threads, do not share files.
+pub fn scratch_subdir(file: &str, name: &str) -> PathBuf {
+    created(scratch_dir(file).join(name))
+}
+
+/// `dir` removed with everything in it and created again, empty: for a test that reads back what
+/// it wrote there (a bag, a report file) and must not find files a test run with the same process
+/// id left.
+pub fn emptied(dir: PathBuf) -> PathBuf {
+    if let Err(e) = std::fs::remove_dir_all(&dir) {
+        assert!(e.kind() == std::io::ErrorKind::NotFound, "cannot empty {}: {e}", dir.display());
+    }
+    created(dir)
+}
+
+fn created(dir: PathBuf) -> PathBuf {
     std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
     dir
 }
@@ -60,9 +80,15 @@ pub fn topology(vertices: &[Vector], triangles: &[[u32; 3]]) -> MeshTopology {
     MeshTopology::build(vertices, triangles, &TopologySettings::default()).expect("the mesh builds")
 }
 
+/// The thickness area of a topology; panics if it does not build. For a test that also reads the
+/// topology, or builds several areas on one.
+pub fn topology_area(topology: &MeshTopology, settings: &ThicknessSettings) -> ThicknessArea {
+    ThicknessArea::build(topology, settings).expect("the cells build")
+}
+
 /// The thickness area of a triangle soup (default topology settings); panics if it does not build.
 pub fn mesh_area(vertices: &[Vector], triangles: &[[u32; 3]], settings: &ThicknessSettings) -> ThicknessArea {
-    ThicknessArea::build(&topology(vertices, triangles), settings).expect("the cells build")
+    topology_area(&topology(vertices, triangles), settings)
 }
 
 /// [`mesh_area`] with only the thickness set (metres).
