@@ -1,40 +1,40 @@
-//! Bounds on everything that comes in from outside: files, messages, numbers. One place, so the
-//! docs (`docs/reference.md`, "Input bounds") and the errors quote the same figures.
+//! Bounds on the files and numbers that come in from outside, in one place, so the docs
+//! (`docs/reference.md`, "Input bounds") and the errors quote the same figures. (The sequences of
+//! a decoded message are bounded where it is decoded, in `msgs`.)
 //!
 //! A bound is there so that one hostile or careless input (a 2 GB description, a mesh that is a
 //! link to `/dev/zero`, an XML tree 20,000 deep, a cylinder of radius 1e300) gets a one-line
 //! error instead of taking the node down: memory, stack and the numeric core all have limits.
+//!
+//! Public: the bounds a front door applies itself ([`LENGTH_RANGE`] with [`is_length`], the state
+//! line's [`MAX_STATE_LINE_BYTES`], a request's [`MAX_TRAJECTORY_SUBINTERVALS`]), the way it opens
+//! an input file ([`open_regular`], [`InputFileError`]) and writes a number into an error
+//! ([`show_number`]). The rest serves the library's own readers.
 
 use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// URDF files, `robot_description` and SRDF text.
-pub const MAX_DESCRIPTION_BYTES: u64 = 16 << 20;
+pub(crate) const MAX_DESCRIPTION_BYTES: u64 = 16 << 20;
 /// The parameters YAML.
-pub const MAX_PARAMS_BYTES: u64 = 1 << 20;
+pub(crate) const MAX_PARAMS_BYTES: u64 = 1 << 20;
 /// Mesh files (STL, OBJ, COLLADA).
-pub const MAX_MESH_BYTES: u64 = 1 << 30;
+pub(crate) const MAX_MESH_BYTES: u64 = 1 << 30;
 /// Triangles of one mesh file.
-pub const MAX_MESH_TRIANGLES: usize = 20_000_000;
+pub(crate) const MAX_MESH_TRIANGLES: usize = 20_000_000;
 /// A line of a `check --states` file.
 pub const MAX_STATE_LINE_BYTES: u64 = 16 << 20;
 /// Nesting of XML elements (URDF, SRDF, COLLADA). Real files stay under 20; the parsers recurse.
-pub const MAX_XML_DEPTH: usize = 256;
+pub(crate) const MAX_XML_DEPTH: usize = 256;
 /// Shortest and longest accepted size (metres): primitive dimensions, thickness. Past 1e4 m the
 /// support functions' products leave the range where an f64 still tells a contact apart.
 pub const LENGTH_RANGE: [f64; 2] = [1e-6, 1e4];
 /// Largest accepted coordinate (metres) of a position: origins, mesh vertices after scaling,
 /// prismatic travel, transforms.
-pub const MAX_COORDINATE: f64 = 1e5;
+pub(crate) const MAX_COORDINATE: f64 = 1e5;
 /// Longest list of names quoted in one error line; the rest are counted.
-pub const MAX_NAMES_IN_ERROR: usize = 8;
-/// Entries one `JointState` field may hold (`msgs::MAX_JOINT_STATE_ENTRIES`, refused while decoding).
-pub use crate::msgs::MAX_JOINT_STATE_ENTRIES;
-/// Points, names and entries of a point's fields a `check_trajectory` request may hold
-/// (`msgs::MAX_TRAJECTORY_ENTRIES`, refused while decoding; the same figures are checked again by
-/// `Pipeline::trajectory_job`, with one-line errors).
-pub use crate::msgs::MAX_TRAJECTORY_ENTRIES;
+pub(crate) const MAX_NAMES_IN_ERROR: usize = 8;
 /// Motion-check sub-intervals one `check_trajectory` request may spend in all (about 100 s of a
 /// worker's time on the bundled workcell).
 pub const MAX_TRAJECTORY_SUBINTERVALS: u64 = 1 << 22;
@@ -125,7 +125,7 @@ pub fn open_regular(path: &Path, what: &'static str, limit: u64) -> Result<(File
 
 /// Reads a whole regular file of at most `limit` bytes (a file that grows while read is cut at
 /// `limit + 1` bytes and refused).
-pub fn read_regular(path: &Path, what: &'static str, limit: u64) -> Result<Vec<u8>, InputFileError> {
+pub(crate) fn read_regular(path: &Path, what: &'static str, limit: u64) -> Result<Vec<u8>, InputFileError> {
     let (file, size) = open_regular(path, what, limit)?;
     let mut bytes = Vec::with_capacity(size as usize);
     let _ = file.take(limit + 1).read_to_end(&mut bytes).map_err(|error| InputFileError::Io { what, path: path.to_owned(), error })?;
@@ -136,7 +136,7 @@ pub fn read_regular(path: &Path, what: &'static str, limit: u64) -> Result<Vec<u
 }
 
 /// [`read_regular`] as UTF-8 text (a leading byte-order mark is dropped).
-pub fn read_regular_text(path: &Path, what: &'static str, limit: u64) -> Result<String, InputFileError> {
+pub(crate) fn read_regular_text(path: &Path, what: &'static str, limit: u64) -> Result<String, InputFileError> {
     let bytes = read_regular(path, what, limit)?;
     let text = String::from_utf8(bytes).map_err(|e| InputFileError::Io {
         what,
@@ -151,7 +151,7 @@ pub fn read_regular_text(path: &Path, what: &'static str, limit: u64) -> Result<
 
 /// The first line of a parser's message, trimmed and cut to 300 characters: some parsers append
 /// a dump of their state (urdf-rs), and an error is one line.
-pub fn first_line(message: &str) -> String {
+pub(crate) fn first_line(message: &str) -> String {
     let line = message.lines().next().unwrap_or("").trim();
     match line.char_indices().nth(300) {
         Some((cut, _)) => format!("{}...", &line[..cut]),
@@ -160,7 +160,7 @@ pub fn first_line(message: &str) -> String {
 }
 
 /// `names` joined with ", ", cut after [`MAX_NAMES_IN_ERROR`] with a count of the rest.
-pub fn name_list<S: AsRef<str>>(names: &[S]) -> String {
+pub(crate) fn name_list<S: AsRef<str>>(names: &[S]) -> String {
     let shown: Vec<&str> = names.iter().take(MAX_NAMES_IN_ERROR).map(AsRef::as_ref).collect();
     let mut s = shown.join(", ");
     if names.len() > MAX_NAMES_IN_ERROR {
@@ -184,7 +184,7 @@ pub fn is_length(v: f64) -> bool {
 }
 
 /// Whether `v` is a coordinate the core accepts (finite, |v| ≤ [`MAX_COORDINATE`]).
-pub fn is_coordinate(v: f64) -> bool {
+pub(crate) fn is_coordinate(v: f64) -> bool {
     v.abs() <= MAX_COORDINATE
 }
 
@@ -196,7 +196,7 @@ thread_local! {
 /// Runs `f`, turning a panic inside it into `Err` with the panic's message and place, printed
 /// nowhere. For code that is not ours and panics on malformed input (mesh-loader); a panic
 /// anywhere else still goes to the hook that was installed before.
-pub fn contain_panic<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+pub(crate) fn contain_panic<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     static HOOK: std::sync::Once = std::sync::Once::new();
     HOOK.call_once(|| {
         let previous = std::panic::take_hook();

@@ -14,7 +14,7 @@ const DELETEALL: i32 = 3;
 
 /// Depth drawn fully red; shallower contacts shade from yellow. A fixed scale, so one colour means
 /// one depth in every message of a recording.
-pub const FULL_DEPTH_COLOR: f64 = 0.05;
+pub(crate) const FULL_DEPTH_COLOR: f64 = 0.05;
 
 /// Shortest normal arrow drawn: a near miss (depth 0 in a motion) still shows its direction.
 const MIN_ARROW: f64 = 0.005;
@@ -29,7 +29,7 @@ fn header(frame: &str, stamp: Time) -> Header {
 
 /// One triangle-list marker per thin surface with the faces of its cells (world frame), at most
 /// `max_cells` cells in all (the first ones of each object in turn).
-pub fn cell_markers(checker: &Checker, max_cells: usize, frame: &str, stamp: Time) -> MarkerArray {
+pub(crate) fn cell_markers(checker: &Checker, max_cells: usize, frame: &str, stamp: Time) -> MarkerArray {
     let mut markers = Vec::new();
     let mut left = max_cells;
     for (id, object) in checker.scene().objects().iter().enumerate() {
@@ -62,7 +62,7 @@ pub fn cell_markers(checker: &Checker, max_cells: usize, frame: &str, stamp: Tim
 }
 
 /// Yellow at depth 0 to red at [`FULL_DEPTH_COLOR`] and beyond.
-pub fn depth_color(depth: f64) -> ColorRgba {
+pub(crate) fn depth_color(depth: f64) -> ColorRgba {
     let s = (depth / FULL_DEPTH_COLOR).clamp(0.0, 1.0) as f32;
     ColorRgba { r: 1.0, g: 0.9 * (1.0 - s), b: 0.0, a: 1.0 }
 }
@@ -72,7 +72,7 @@ pub fn depth_color(depth: f64) -> ColorRgba {
 /// per contact from its point along its normal, as long as its depth (`normals`), and the link and
 /// object as text at the point (`labels`). A report without contacts gives the `DELETEALL` alone.
 /// `lifetime` zero keeps them until the next report's `DELETEALL`.
-pub fn contact_markers(report: &StateReport, frame: &str, stamp: Time, lifetime: DurationMsg) -> MarkerArray {
+pub(crate) fn contact_markers(report: &StateReport, frame: &str, stamp: Time, lifetime: DurationMsg) -> MarkerArray {
     let base = Marker { header: header(frame, stamp), lifetime, pose: PoseMsg::default(), ..Default::default() };
     let mut markers = vec![Marker { action: DELETEALL, lifetime: DurationMsg::default(), ..base.clone() }];
     // A flags-only contact has no point to draw.

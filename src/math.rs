@@ -12,7 +12,7 @@ pub use parry3d_f64::bounding_volume::Aabb;
 
 /// `[min, max]` of `dir . p` over `points` (the projection of a point set on an axis).
 #[inline]
-pub fn project_points(points: &[Vector], dir: Vector) -> [Real; 2] {
+pub(crate) fn project_points(points: &[Vector], dir: Vector) -> [Real; 2] {
     let mut lo = Real::INFINITY;
     let mut hi = Real::NEG_INFINITY;
     for p in points {
@@ -28,7 +28,7 @@ pub fn project_points(points: &[Vector], dir: Vector) -> [Real; 2] {
 /// Returns `None` when the normals are linearly dependent relative to their lengths
 /// (`|det| <= eps * |n0||n1||n2|`): the planes do not meet in one point.
 #[inline]
-pub fn intersect_three_planes(n: [Vector; 3], d: [Real; 3], eps: Real) -> Option<Vector> {
+pub(crate) fn intersect_three_planes(n: [Vector; 3], d: [Real; 3], eps: Real) -> Option<Vector> {
     let c12 = n[1].cross(n[2]);
     let det = n[0].dot(c12);
     let scale = n[0].length() * n[1].length() * n[2].length();
@@ -44,7 +44,8 @@ pub fn intersect_three_planes(n: [Vector; 3], d: [Real; 3], eps: Real) -> Option
 }
 
 /// A pose as the Python peers read it (`tests/peers/hull_parts.py`, coal's `Transform3s`): the
-/// rotation matrix row by row, then the translation.
+/// rotation matrix row by row, then the translation. A test fixture (feature `testing`).
+#[cfg(feature = "testing")]
 pub fn pose_rows(p: &Pose) -> [Real; 12] {
     // glam's `DMat3::from_quat`, term for term, so the peers see the matrices they always saw.
     let q = p.rotation;

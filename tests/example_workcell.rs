@@ -6,7 +6,7 @@ mod common;
 use std::path::PathBuf;
 use thickness_collision::math::Vector;
 use thickness_collision::model::example_workcell::example_meshes;
-use thickness_collision::model::mesh_file::{read_mesh, write_obj};
+use thickness_collision::model::{read_mesh, write_obj};
 
 #[test]
 fn example_meshes_are_current_and_open() {

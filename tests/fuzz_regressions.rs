@@ -127,7 +127,7 @@ fn trajectory_seeds_decode_and_reach_the_check() {
 
 #[test]
 fn validity_seeds_decode_and_reach_the_check() {
-    use thickness_collision::msgs::moveit::GetStateValidityRequest;
+    use thickness_collision::fuzz_access::{GetStateValidityRequest, PipelineAccess};
     use thickness_collision::replay::decode_cdr;
     let mut seen = 0;
     for (_, name, bytes) in seeds().into_iter().filter(|s| s.0 == "check_state_validity") {

@@ -10,7 +10,7 @@ use serde_json::json;
 use std::process::Command;
 use thickness_collision::math::{Pose, Rotation, Vector};
 use thickness_collision::mesh::generate;
-use thickness_collision::model::mesh_file::{read_mesh, write_obj};
+use thickness_collision::model::{read_mesh, write_obj};
 
 const WALL_X: f64 = 0.5;
 const T: f64 = 0.02;

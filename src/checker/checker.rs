@@ -87,7 +87,7 @@ impl Checker {
 
     /// Whether joint `j` (model index) moves a checked link and takes its position from joint
     /// states: the joints a state must give before it can be checked.
-    pub fn moves_checked_link(&self, j: usize) -> bool {
+    pub(crate) fn moves_checked_link(&self, j: usize) -> bool {
         self.moving.get(j).copied().unwrap_or(false)
     }
 

@@ -10,7 +10,7 @@ use super::self_pairs::SelfPairs;
 use crate::collision::{ConvexHull, Scene, TargetShape};
 use crate::math::pose_from_isometry;
 use crate::mesh::{MeshTopology, TopologySettings};
-use crate::model::mesh_file::MeshData;
+use crate::model::MeshData;
 use crate::model::{GeometrySpec, LinkModel, ModelError, PackageResolver, Params, RobotModel, Srdf};
 use crate::thickness::{Side, ThicknessArea, ThicknessSettings};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
@@ -41,7 +41,7 @@ impl Checker {
     /// As [`Checker::from_params`], but with the robot from URDF text (a `robot_description`
     /// message); `source` names it in errors. Mesh paths must be `package://`, `file://` or
     /// absolute.
-    pub fn from_description(params: Params, description: &str, source: &str) -> Result<Checker, CheckerError> {
+    pub(crate) fn from_description(params: Params, description: &str, source: &str) -> Result<Checker, CheckerError> {
         params.validate()?;
         let resolver = PackageResolver::new(&params.package_map);
         let env_path = params.environment_path();
@@ -136,7 +136,7 @@ impl Checker {
     /// The same checker with the allowed collision matrix of SRDF `text` (`source` names it in
     /// errors); the robot and environment are kept. An SRDF naming a link or joint the robot
     /// lacks is refused.
-    pub fn with_semantic(mut self, text: &str, source: &str) -> Result<Checker, CheckerError> {
+    pub(crate) fn with_semantic(mut self, text: &str, source: &str) -> Result<Checker, CheckerError> {
         self.apply_semantic(text, source)?;
         Ok(self)
     }
@@ -144,7 +144,7 @@ impl Checker {
     /// This checker with the allowed collision matrix of SRDF `text` in place of its own: robot,
     /// targets and scene are shared or copied, not loaded again (an SRDF that arrives on its topic
     /// after the robot must not cost a second build of a million-cell world).
-    pub fn with_other_semantic(&self, text: &str, source: &str) -> Result<Checker, CheckerError> {
+    pub(crate) fn with_other_semantic(&self, text: &str, source: &str) -> Result<Checker, CheckerError> {
         let checker = Checker {
             params: self.params.clone(),
             robot: self.robot.clone(),
@@ -161,7 +161,7 @@ impl Checker {
     }
 
     /// As [`Checker::with_semantic`], in place; on error nothing changes.
-    pub fn apply_semantic(&mut self, text: &str, source: &str) -> Result<(), CheckerError> {
+    pub(crate) fn apply_semantic(&mut self, text: &str, source: &str) -> Result<(), CheckerError> {
         let srdf = Srdf::parse(text, source, &self.robot).map_err(|e| CheckerError::Srdf(e.to_string()))?;
         self.self_pairs = SelfPairs::build(self, Some(srdf));
         Ok(())

@@ -1,6 +1,6 @@
 //! Why a checker cannot be built.
 
-use crate::model::mesh_file::MeshFileError;
+use crate::model::MeshFileError;
 use crate::model::{ModelError, ParamsError};
 
 /// Why a checker cannot be built.

@@ -2,8 +2,8 @@
 
 use crate::collision::TargetShape;
 use crate::math::Vector;
-use crate::model::mesh_file::{read_mesh, scale_mesh, MeshData, MeshFileError};
 use crate::model::GeometrySpec;
+use crate::model::{read_mesh, scale_mesh, MeshData, MeshFileError};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

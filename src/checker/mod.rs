@@ -27,6 +27,6 @@ pub use self::checker_error::CheckerError;
 pub(crate) use self::joint_state::require_own_joints;
 pub use self::joint_state::StateError;
 pub use self::link_targets::LinkTargets;
-pub use self::motion_sweep::{MotionReport, MAX_SUBINTERVALS};
+pub use self::motion_sweep::MotionReport;
 pub use self::self_pairs::SelfPairs;
 pub use self::state_report::{ObjectType, ReportClearance, ReportContact, StateReport};

@@ -12,7 +12,7 @@ use crate::math::{Pose, Real};
 use std::collections::hash_map::{Entry, HashMap};
 
 /// Sub-intervals examined at most per motion; past that the motion fails closed.
-pub const MAX_SUBINTERVALS: u64 = 1 << 20;
+pub(crate) const MAX_SUBINTERVALS: u64 = 1 << 20;
 
 /// Growth above which a sub-interval is split without being tested (metres): it only saves work.
 /// On the motion benchmark (Panda, 1M cells, 2,000 motions) links grown by more than 0.36 m were

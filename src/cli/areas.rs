@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use thickness_collision::math::Vector;
 use thickness_collision::mesh::{MeshTopology, TopologySettings};
-use thickness_collision::model::mesh_file::read_mesh;
+use thickness_collision::model::read_mesh;
 use thickness_collision::thickness::{Side, ThicknessArea, ThicknessReport, ThicknessSettings};
 
 fn parse_scale(s: &str) -> Result<Vector> {

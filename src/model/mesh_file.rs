@@ -60,7 +60,7 @@ pub enum MeshFileError {
 /// number of negative factors mirrors the mesh; the winding is then reversed to keep the normals
 /// pointing out of the same side.
 ///
-/// Only a regular file of at most [`MAX_MESH_BYTES`] is read.
+/// Only a regular file of at most 1 GiB (`limits::MAX_MESH_BYTES`) is read.
 pub fn read_mesh(path: &Path, scale: Vector) -> Result<MeshData, MeshFileError> {
     let _ = format_of(path)?;
     let bytes = read_regular(path, "mesh file", MAX_MESH_BYTES).map_err(|e| MeshFileError::Input(Box::new(e)))?;
@@ -80,7 +80,7 @@ fn format_of(path: &Path) -> Result<&'static str, MeshFileError> {
 /// names the mesh in errors.
 ///
 /// mesh-loader panics or aborts on some malformed COLLADA and OBJ; the guards before it refuse
-/// what is known to do that ([`check_xml`], [`check_collada`]), and a panic that still happens is
+/// what is known to do that (`xml_guard::check_xml`, `collada_guard::check_collada`), and a panic that still happens is
 /// contained and reported as a parse error, so no mesh can take the process down.
 pub fn parse_mesh(bytes: &[u8], path: &Path, scale: Vector) -> Result<MeshData, MeshFileError> {
     let parse = |message: String| MeshFileError::Parse { path: path.to_owned(), message };
@@ -207,7 +207,7 @@ fn obj_positions_only(bytes: &[u8]) -> Result<Option<Vec<u8>>, String> {
 
 /// `data` scaled per axis (the winding reversed for a mirroring scale), with every vertex within
 /// [`MAX_COORDINATE`] and the mesh at least [`LENGTH_RANGE`]`[0]` across.
-pub fn scale_mesh(data: &MeshData, scale: Vector, path: &Path) -> Result<MeshData, MeshFileError> {
+pub(crate) fn scale_mesh(data: &MeshData, scale: Vector, path: &Path) -> Result<MeshData, MeshFileError> {
     if let Some(s) = scale.to_array().into_iter().find(|s| !(s.is_finite() && *s != 0.0)) {
         return Err(MeshFileError::Parse { path: path.to_owned(), message: format!("scale {s} is not a finite, non-zero number") });
     }
@@ -271,7 +271,9 @@ fn read_binary_stl(bytes: &[u8]) -> Result<MeshData, String> {
     Ok(data)
 }
 
-/// Writes a mesh as Wavefront OBJ (vertices in metres, faces 1-based, counter-clockwise fronts).
+/// Writes a mesh as Wavefront OBJ (vertices in metres, faces 1-based, counter-clockwise fronts):
+/// how the tests write the generated example meshes and their fixtures (feature `testing`).
+#[cfg(feature = "testing")]
 pub fn write_obj(path: &Path, vertices: &[Vector], triangles: &[[u32; 3]], comment: &str) -> std::io::Result<()> {
     use std::io::Write;
     let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);

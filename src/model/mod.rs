@@ -2,10 +2,11 @@
 //! `package://` URIs, the parameters file, and forward kinematics.
 
 mod bundled;
-pub mod collada_guard;
+mod collada_guard;
 #[cfg(feature = "testing")]
 pub mod example_workcell;
-pub mod mesh_file;
+// Crate-visible for `fuzz_access`, which hands the fuzz harness the parser behind `read_mesh`.
+pub(crate) mod mesh_file;
 mod package;
 mod params;
 mod params_file;
@@ -13,11 +14,15 @@ mod robot;
 mod robot_parse;
 mod srdf;
 mod xacro;
-pub mod xml_guard;
+mod xml_guard;
 
 pub use self::bundled::bundled_config_dir;
+pub(crate) use self::mesh_file::scale_mesh;
+#[cfg(feature = "testing")]
+pub use self::mesh_file::write_obj;
+pub use self::mesh_file::{read_mesh, MeshData, MeshFileError};
 pub use self::package::{PackageError, PackageResolver};
-pub use self::params::{glob_match, InputFiles, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};
+pub use self::params::{InputFiles, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};
 pub use self::params_file::{node_fqn, LoadedParams, DEFAULT_NODE_FQN};
 pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, PositionsError, RobotModel};
 pub use self::srdf::{Srdf, SrdfError};

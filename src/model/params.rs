@@ -262,7 +262,7 @@ impl Params {
     }
 
     /// Whether no robot file is named, so that the bundled arm stands in.
-    pub fn robot_is_bundled(&self) -> bool {
+    pub(crate) fn robot_is_bundled(&self) -> bool {
         self.input_files.robot.is_none() && self.robot_description_file.is_empty()
     }
 
@@ -327,7 +327,7 @@ impl Params {
     }
 
     /// Thickness and side of the thin surface on environment link `link`.
-    pub fn surface_settings(&self, link: &str) -> (f64, Side) {
+    pub(crate) fn surface_settings(&self, link: &str) -> (f64, Side) {
         let ts = &self.thin_surfaces;
         // validate() keeps the arrays parallel; a pattern without its thickness falls back.
         match ts.patterns.iter().position(|p| glob_match(p, link)) {
@@ -337,12 +337,12 @@ impl Params {
     }
 
     /// Padding of robot link `link` (metres).
-    pub fn padding_of(&self, link: &str) -> f64 {
+    pub(crate) fn padding_of(&self, link: &str) -> f64 {
         self.padding.links.iter().position(|p| glob_match(p, link)).and_then(|i| self.padding.values.get(i).copied()).unwrap_or(0.0)
     }
 
     /// Whether a collision between robot link `link` and environment link `object` is allowed.
-    pub fn is_allowed(&self, link: &str, object: &str) -> bool {
+    pub(crate) fn is_allowed(&self, link: &str, object: &str) -> bool {
         self.allowed_collisions.iter().any(|pair| match pair.split_once(':') {
             Some((l, o)) => glob_match(l, link) && glob_match(o, object),
             None => false,
@@ -350,12 +350,12 @@ impl Params {
     }
 
     /// Whether robot link `link` is checked.
-    pub fn is_checked(&self, link: &str) -> bool {
+    pub(crate) fn is_checked(&self, link: &str) -> bool {
         self.checked_links.iter().any(|p| glob_match(p, link))
     }
 
     /// Whether the closed meshes of environment link `link` are checked as convex hulls.
-    pub fn is_solid_hull(&self, link: &str) -> bool {
+    pub(crate) fn is_solid_hull(&self, link: &str) -> bool {
         self.solid_hull.iter().any(|p| glob_match(p, link))
     }
 
@@ -382,8 +382,10 @@ impl Params {
         out
     }
 
-    /// The element of every list parameter, by dotted name: what an empty list would hold.
-    pub fn array_kinds() -> Vec<(String, serde_json::Value)> {
+    /// The element of every list parameter, by dotted name: what an empty list would hold (the
+    /// node declares its parameters with them).
+    #[cfg(feature = "ros")]
+    pub(crate) fn array_kinds() -> Vec<(String, serde_json::Value)> {
         let sample = Params {
             robot_base_pose: vec![0.0],
             package_map: vec![String::new()],
@@ -464,7 +466,7 @@ pub(super) fn show_keys(keys: &[String]) -> String {
 }
 
 /// Glob match with `*` (any run) and `?` (one character).
-pub fn glob_match(pattern: &str, text: &str) -> bool {
+pub(crate) fn glob_match(pattern: &str, text: &str) -> bool {
     let (p, t): (Vec<char>, Vec<char>) = (pattern.chars().collect(), text.chars().collect());
     let (mut pi, mut ti, mut star, mut mark) = (0, 0, None, 0);
     while ti < t.len() {

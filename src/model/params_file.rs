@@ -50,7 +50,7 @@ impl Params {
     }
 
     /// Parses a ROS 2 parameters YAML for the node named `node_fqn` (`/ns/name`).
-    pub fn from_yaml_for_node(text: &str, path: &Path, node_fqn: &str) -> Result<LoadedParams, ParamsError> {
+    pub(crate) fn from_yaml_for_node(text: &str, path: &Path, node_fqn: &str) -> Result<LoadedParams, ParamsError> {
         let mut sections = Vec::new();
         read_sections(text, 0, path, &mut sections)?;
         merge_sections(&sections, &[path.to_owned()], node_fqn)

@@ -212,7 +212,7 @@ pub struct RobotModel {
 
 impl RobotModel {
     /// The joint whose child link `link` is; `None` for the root (or an index out of range).
-    pub fn parent_joint(&self, link: usize) -> Option<usize> {
+    pub(crate) fn parent_joint(&self, link: usize) -> Option<usize> {
         self.parent_joint.get(link).copied().flatten()
     }
 
@@ -227,7 +227,7 @@ impl RobotModel {
     }
 
     /// The error [`RobotModel::forward_kinematics`] would give for `positions`, without the poses.
-    pub fn validate_positions(&self, positions: &[f64]) -> Result<(), PositionsError> {
+    pub(crate) fn validate_positions(&self, positions: &[f64]) -> Result<(), PositionsError> {
         if positions.len() != self.joints.len() {
             return Err(PositionsError::Length { expected: self.joints.len(), got: positions.len() });
         }

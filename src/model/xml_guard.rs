@@ -9,7 +9,7 @@ use crate::limits::MAX_XML_DEPTH;
 /// Why the text was refused; `Display` is one line naming the line of the text.
 #[derive(Debug, thiserror::Error, PartialEq)]
 #[non_exhaustive]
-pub enum XmlGuardError {
+pub(crate) enum XmlGuardError {
     /// Elements nested deeper than allowed.
     #[error("line {line}: elements nested more than {MAX_XML_DEPTH} deep")]
     TooDeep {
@@ -38,7 +38,7 @@ fn find(hay: &[u8], from: usize, needle: &[u8]) -> Option<usize> {
 
 /// Checks nesting depth and the absence of a DTD. Malformed XML otherwise passes: the parser
 /// that comes next reports it in its own words.
-pub fn check_xml(text: &[u8]) -> Result<(), XmlGuardError> {
+pub(crate) fn check_xml(text: &[u8]) -> Result<(), XmlGuardError> {
     let line_at = |pos: usize| 1 + text[..pos.min(text.len())].iter().filter(|&&b| b == b'\n').count();
     let mut depth = 0usize;
     let mut i = 0usize;
@@ -89,7 +89,7 @@ pub fn check_xml(text: &[u8]) -> Result<(), XmlGuardError> {
 
 /// A start or end tag seen by [`for_each_tag`].
 #[derive(Debug)]
-pub struct Tag<'a> {
+pub(crate) struct Tag<'a> {
     /// 1-based line of its `<`.
     pub line: usize,
     /// Element name.
@@ -103,7 +103,7 @@ pub struct Tag<'a> {
 }
 
 /// Calls `f` for every start and end tag of text [`check_xml`] accepted, in a loop.
-pub fn for_each_tag<'a>(text: &'a str, mut f: impl FnMut(&Tag<'a>) -> Result<(), String>) -> Result<(), String> {
+pub(crate) fn for_each_tag<'a>(text: &'a str, mut f: impl FnMut(&Tag<'a>) -> Result<(), String>) -> Result<(), String> {
     let bytes = text.as_bytes();
     let mut line = 1usize;
     let mut counted = 0usize;

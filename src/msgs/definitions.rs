@@ -2,13 +2,13 @@
 //! dependency, each after a line of 80 `=` and `MSG: pkg/Type`, as rosbag2 writes them.
 
 /// The ROS type name of the reports.
-pub const COLLISION_REPORT_TYPE: &str = "thickness_collision_msgs/msg/CollisionReport";
+pub(crate) const COLLISION_REPORT_TYPE: &str = "thickness_collision_msgs/msg/CollisionReport";
 /// The markers' type.
-pub const MARKER_ARRAY_TYPE: &str = "visualization_msgs/msg/MarkerArray";
+pub(crate) const MARKER_ARRAY_TYPE: &str = "visualization_msgs/msg/MarkerArray";
 /// `/tf` and `/tf_static`.
-pub const TF_MESSAGE_TYPE: &str = "tf2_msgs/msg/TFMessage";
+pub(crate) const TF_MESSAGE_TYPE: &str = "tf2_msgs/msg/TFMessage";
 /// `/robot_description`.
-pub const STRING_TYPE: &str = "std_msgs/msg/String";
+pub(crate) const STRING_TYPE: &str = "std_msgs/msg/String";
 
 const SEPARATOR: &str = "================================================================================";
 
@@ -71,7 +71,7 @@ const TRANSFORM: &str = "geometry_msgs/Vector3 translation\ngeometry_msgs/Quater
 const STRING: &str = "string data\n";
 
 /// The full `ros2msg` definition of a type this crate writes, or `None`.
-pub fn full_definition(type_name: &str) -> Option<String> {
+pub(crate) fn full_definition(type_name: &str) -> Option<String> {
     let (main, deps): (&str, &[(&str, &str)]) = match type_name {
         COLLISION_REPORT_TYPE => (
             COLLISION_REPORT,

@@ -9,17 +9,17 @@
 mod bounded;
 mod check_states;
 mod definitions;
-pub mod moveit;
+pub(crate) mod moveit;
 
 pub use self::check_states::{CheckStatesRequest, CheckStatesResponse};
-pub use self::definitions::{full_definition, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};
+pub(crate) use self::definitions::{full_definition, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};
 
 use serde::{Deserialize, Deserializer, Serialize};
 
 /// Entries a `JointState` field may hold when decoded (a robot has hundreds of joints at most).
 /// A longer sequence is refused while it is read, before its elements are allocated: a
 /// million made-up names would otherwise cost some 60 MB of strings per message.
-pub const MAX_JOINT_STATE_ENTRIES: usize = 65_536;
+pub(crate) const MAX_JOINT_STATE_ENTRIES: usize = 65_536;
 
 /// A sequence of at most [`MAX_JOINT_STATE_ENTRIES`], refused as soon as it runs past.
 fn bounded_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
@@ -215,7 +215,7 @@ pub struct ClearanceMsg {
 
 /// `std_msgs/msg/ColorRGBA`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ColorRgba {
+pub(crate) struct ColorRgba {
     /// Red.
     pub r: f32,
     /// Green.
@@ -246,7 +246,7 @@ pub struct DurationMsg {
 
 /// `sensor_msgs/msg/CompressedImage` (empty in markers).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct CompressedImage {
+pub(crate) struct CompressedImage {
     /// Header.
     pub header: Header,
     /// Format.
@@ -257,7 +257,7 @@ pub struct CompressedImage {
 
 /// `visualization_msgs/msg/UVCoordinate`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct UvCoordinate {
+pub(crate) struct UvCoordinate {
     /// u.
     pub u: f32,
     /// v.
@@ -266,7 +266,7 @@ pub struct UvCoordinate {
 
 /// `visualization_msgs/msg/MeshFile`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct MeshFile {
+pub(crate) struct MeshFile {
     /// File name.
     pub filename: String,
     /// Data.
@@ -275,7 +275,7 @@ pub struct MeshFile {
 
 /// `visualization_msgs/msg/Marker` (the Iron/Jazzy layout, with texture and mesh file fields).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Marker {
+pub(crate) struct Marker {
     /// Header.
     pub header: Header,
     /// Namespace.
@@ -319,14 +319,15 @@ pub struct Marker {
 
 /// `visualization_msgs/msg/MarkerArray`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct MarkerArray {
+pub(crate) struct MarkerArray {
     /// Markers.
     pub markers: Vec<Marker>,
 }
 
 /// `diagnostic_msgs/msg/KeyValue`.
+#[cfg(feature = "ros")]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct KeyValue {
+pub(crate) struct KeyValue {
     /// Key.
     pub key: String,
     /// Value.
@@ -334,8 +335,9 @@ pub struct KeyValue {
 }
 
 /// `diagnostic_msgs/msg/DiagnosticStatus`.
+#[cfg(feature = "ros")]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct DiagnosticStatus {
+pub(crate) struct DiagnosticStatus {
     /// 0 OK, 1 WARN, 2 ERROR, 3 STALE.
     pub level: u8,
     /// Name.
@@ -349,8 +351,9 @@ pub struct DiagnosticStatus {
 }
 
 /// `diagnostic_msgs/msg/DiagnosticArray`.
+#[cfg(feature = "ros")]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct DiagnosticArray {
+pub(crate) struct DiagnosticArray {
     /// Header.
     pub header: Header,
     /// Statuses.
@@ -360,7 +363,7 @@ pub struct DiagnosticArray {
 /// Points, joint names, and entries of one point's fields a `trajectory_msgs/JointTrajectory`
 /// may hold when decoded. A longer sequence is refused while it is read, before its elements are
 /// allocated (an empty point costs 24 bytes on the wire and some 100 in memory).
-pub const MAX_TRAJECTORY_ENTRIES: usize = 65_536;
+pub(crate) const MAX_TRAJECTORY_ENTRIES: usize = 65_536;
 
 /// A trajectory sequence of at most [`MAX_TRAJECTORY_ENTRIES`], refused as soon as it runs past.
 fn bounded_trajectory_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {

@@ -15,7 +15,7 @@ pub(crate) struct JointInput {
 
 impl JointInput {
     /// Nothing received yet for any joint of `robot`.
-    pub fn new(checker: &Checker) -> JointInput {
+    pub(crate) fn new(checker: &Checker) -> JointInput {
         JointInput { received: vec![None; checker.robot().joints.len()] }
     }
 
@@ -25,7 +25,7 @@ impl JointInput {
     /// share the topic) and pushed to `unknown`. Under `last`, a merged state still lacking a joint
     /// that moves a checked link is not a state yet (MoveIt's current state monitor waits for a
     /// complete state likewise).
-    pub fn ingest(
+    pub(crate) fn ingest(
         &mut self,
         checker: &Checker,
         missing: MissingJoint,
@@ -76,7 +76,7 @@ impl JointInput {
 
     /// The positions received so far, by joint index (`None`: never received, or cleared under
     /// `missing_joint: zero`).
-    pub fn current(&self) -> &[Option<f64>] {
+    pub(crate) fn current(&self) -> &[Option<f64>] {
         &self.received
     }
 }

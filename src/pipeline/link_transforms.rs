@@ -10,7 +10,7 @@ use crate::msgs::{Header, Quaternion, TfMessage, Time, Transform, TransformStamp
 /// The frame names already in `out` are kept (a replay writing one message per state then
 /// allocates no strings): pass an empty message after the checker changed, or the names may be
 /// another robot's.
-pub fn link_transforms(checker: &Checker, world: &str, prefix: &str, q: &[f64], stamp: Time, out: &mut TfMessage) -> bool {
+pub(crate) fn link_transforms(checker: &Checker, world: &str, prefix: &str, q: &[f64], stamp: Time, out: &mut TfMessage) -> bool {
     let robot = checker.robot();
     let Ok(poses) = robot.forward_kinematics(q, checker.base_pose()) else { return false };
     // A root link named like the world frame would be its own parent.

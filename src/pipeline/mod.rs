@@ -18,13 +18,17 @@ mod tf_tree;
 mod trajectory;
 mod validity;
 
-pub use self::link_transforms::link_transforms;
 pub use self::report_adapter::{report_message, CheckedState};
 pub use self::skip::{Skip, SkipCause};
 pub use self::state_line::{parse_state_line, LinkTransform, StateLine};
 pub use self::state_pipeline::{Pipeline, RobotState};
-pub use self::trajectory::{TrajectoryJob, MAX_TRAJECTORY_NAMES, MAX_TRAJECTORY_POINTS, MAX_TRAJECTORY_SUBINTERVALS};
-pub use self::validity::ValidityJob;
+
+// The node's and replay's own steps: `/tf` of a state, and the request jobs the node's workers run
+// (the fuzz harness reaches the jobs through `fuzz_access`).
+pub(crate) use self::link_transforms::link_transforms;
+pub(crate) use self::trajectory::TrajectoryJob;
+#[cfg(feature = "ros")]
+pub(crate) use self::validity::ValidityJob;
 
 #[cfg(test)]
 mod pipeline_tests;

@@ -43,7 +43,7 @@ pub struct RobotState {
 impl RobotState {
     /// The joint positions of a state made from a joint state (None for one made of link poses:
     /// its `/tf` came with the input). With [`link_transforms`] they give the state's `/tf`.
-    pub fn joint_positions(&self) -> Option<&[f64]> {
+    pub(crate) fn joint_positions(&self) -> Option<&[f64]> {
         match &self.pose {
             StatePose::Joints(q) => Some(q),
             StatePose::Links(_) => None,
@@ -115,7 +115,7 @@ impl Pipeline {
     /// an SRDF file that does not fit the bundled arm is not refused here: it is meant for the
     /// robot to come, and is checked against each description as it arrives (one it does not fit
     /// is refused). [`Pipeline::semantic_deferred`] says whether that is waiting.
-    pub fn new_expecting_description(params: Params) -> Result<Pipeline, CheckerError> {
+    pub(crate) fn new_expecting_description(params: Params) -> Result<Pipeline, CheckerError> {
         let placeholder = params.robot_is_bundled();
         match Pipeline::new(params.clone()) {
             Err(CheckerError::Srdf(_)) if placeholder && !params.robot_semantic_file.is_empty() => {
@@ -136,7 +136,7 @@ impl Pipeline {
 
     /// Whether the parameters' SRDF waits for a `robot_description` it fits (see
     /// [`Pipeline::new_expecting_description`]): true until one has been applied with it.
-    pub fn semantic_deferred(&self) -> bool {
+    pub(crate) fn semantic_deferred(&self) -> bool {
         self.semantic_deferred && !matches!(self.source, RobotSource::Description { .. })
     }
 
@@ -156,7 +156,7 @@ impl Pipeline {
     }
 
     /// Counts skipped messages the front door decided on (undecodable payloads, stale states).
-    pub fn count_skip(&mut self, cause: SkipCause, n: u64) {
+    pub(crate) fn count_skip(&mut self, cause: SkipCause, n: u64) {
         if n > 0 {
             *self.skipped.entry(cause).or_insert(0) += n;
         }
@@ -280,7 +280,7 @@ impl Pipeline {
 
     /// The URDF text of the robot in force, for viewers that draw it: the `robot_description`
     /// received, else the file `--robot` or the parameters name (else the bundled arm's), read now.
-    pub fn robot_urdf(&self) -> Result<String, crate::limits::InputFileError> {
+    pub(crate) fn robot_urdf(&self) -> Result<String, crate::limits::InputFileError> {
         match &self.source {
             RobotSource::Description { urdf, .. } => Ok(urdf.to_string()),
             RobotSource::Files => crate::limits::read_regular_text(&self.params().robot_path(), "robot URDF", crate::limits::MAX_DESCRIPTION_BYTES),
@@ -295,7 +295,7 @@ impl Pipeline {
     /// along the polyline is reported, its `fraction` counting each state as an equal step
     /// ((i + f) / n for step i of n). Without `check_motion`, the newest state alone, older
     /// ones counted `stale`. `None` for no states.
-    pub fn check_path(&mut self, states: &[RobotState]) -> Option<CheckedState> {
+    pub(crate) fn check_path(&mut self, states: &[RobotState]) -> Option<CheckedState> {
         let newest = states.last()?;
         if !self.params().check_motion {
             self.count_skip(SkipCause::Stale, states.len() as u64 - 1);
@@ -340,7 +340,7 @@ impl Pipeline {
     /// A `check_states` request: every state on its own, every name a joint of the robot; one
     /// report per state, in order, a state that cannot be checked failing closed in its slot.
     /// Checked on all cores with the `parallel` feature.
-    pub fn check_request(&self, states: &[JointState]) -> Vec<CollisionReport> {
+    pub(crate) fn check_request(&self, states: &[JointState]) -> Vec<CollisionReport> {
         let pairs: Vec<(&[String], &[f64])> = states.iter().map(|s| (s.name.as_slice(), s.position.as_slice())).collect();
         let frame = &self.params().world_frame;
         self.checker

@@ -24,11 +24,11 @@ pub(crate) enum TfRejection {
 impl TfTree {
     /// Frames kept at most (a robot cell has hundreds): a flood of made-up frames must not grow
     /// memory.
-    pub const MAX_FRAMES: usize = 10_000;
+    pub(crate) const MAX_FRAMES: usize = 10_000;
 
     /// Applies every transform of a message, or none: a message with one bad transform would
     /// leave the tree half old, half new.
-    pub fn update(&mut self, msg: &TfMessage) -> Result<(), TfRejection> {
+    pub(crate) fn update(&mut self, msg: &TfMessage) -> Result<(), TfRejection> {
         let mut parsed = Vec::with_capacity(msg.transforms.len());
         let mut new_frames = 0;
         let mut seen = rustc_hash::FxHashSet::default();
@@ -59,7 +59,7 @@ impl TfTree {
 
     /// The pose of `frame` in `world`, if the chain of parents reaches it (at most 256 steps: a
     /// cycle in the input must not loop).
-    pub fn world_pose(&self, frame: &str, world: &str) -> Option<Pose> {
+    pub(crate) fn world_pose(&self, frame: &str, world: &str) -> Option<Pose> {
         let (frame, world) = (strip(frame), strip(world));
         if frame == world {
             return Some(Pose::IDENTITY);

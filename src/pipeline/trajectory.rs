@@ -27,13 +27,13 @@ use crate::msgs::{CheckTrajectoryResponse, DurationMsg, JointTrajectory, Time, M
 use std::sync::Arc;
 
 /// Points a trajectory may have (the decoder refuses longer sequences already).
-pub const MAX_TRAJECTORY_POINTS: usize = MAX_TRAJECTORY_ENTRIES;
+pub(crate) const MAX_TRAJECTORY_POINTS: usize = MAX_TRAJECTORY_ENTRIES;
 
-pub use crate::limits::MAX_TRAJECTORY_SUBINTERVALS;
+use crate::limits::MAX_TRAJECTORY_SUBINTERVALS;
 
 /// Names a trajectory may give (more than any robot has joints; the decoder refuses longer lists
 /// already).
-pub const MAX_TRAJECTORY_NAMES: usize = MAX_TRAJECTORY_ENTRIES;
+pub(crate) const MAX_TRAJECTORY_NAMES: usize = MAX_TRAJECTORY_ENTRIES;
 
 /// A validated trajectory with the positions of every joint at every point, and the checker to
 /// walk it with: ready to run on any thread.
@@ -61,13 +61,14 @@ struct Plan {
 impl Pipeline {
     /// Validates `trajectory` and resolves every point to positions of every joint, joints it does
     /// not name from the current merged state. Cheap (no geometry); see [`TrajectoryJob::run`].
-    pub fn trajectory_job(&self, trajectory: &JointTrajectory) -> TrajectoryJob {
+    pub(crate) fn trajectory_job(&self, trajectory: &JointTrajectory) -> TrajectoryJob {
         let plan = resolve(self, trajectory);
         TrajectoryJob { checker: self.checker().clone(), plan }
     }
 
-    /// A `check_trajectory` request answered on this thread: [`Pipeline::trajectory_job`] then
-    /// [`TrajectoryJob::run`].
+    /// A `check_trajectory` request answered on this thread: validated and resolved against the
+    /// current merged state, then walked segment by segment with the motion check, as the node's
+    /// worker walks it.
     pub fn check_trajectory(&self, trajectory: &JointTrajectory) -> CheckTrajectoryResponse {
         self.trajectory_job(trajectory).run()
     }

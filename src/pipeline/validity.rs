@@ -36,7 +36,7 @@ use std::sync::Arc;
 /// A validated request with a position for every joint and the links it covers: ready to run on
 /// any thread.
 #[derive(Clone)]
-pub struct ValidityJob {
+pub(crate) struct ValidityJob {
     checker: Arc<Checker>,
     /// The resolved state, or why the request is refused.
     plan: Result<Plan, String>,
@@ -63,7 +63,7 @@ struct Plan {
 impl Pipeline {
     /// Validates `req` and resolves it to a position for every joint and the links its group
     /// covers. Cheap (no geometry); see [`ValidityJob::run`].
-    pub fn validity_job(&self, req: &GetStateValidityRequest) -> ValidityJob {
+    pub(crate) fn validity_job(&self, req: &GetStateValidityRequest) -> ValidityJob {
         let (links, warning) = group_links(self.checker(), &req.group_name);
         let plan = refusal(self.checker().robot(), req).map_or_else(|| resolve(self, req).map(|q| Plan { q, links }), Err);
         ValidityJob { checker: self.checker().clone(), plan, stamp: req.robot_state.joint_state.header.stamp, warning }
@@ -71,7 +71,7 @@ impl Pipeline {
 
     /// A `check_state_validity` request answered on this thread: the response, and why the
     /// request could not be honoured (then `valid` is false and there are no contacts).
-    pub fn check_validity(&self, req: &GetStateValidityRequest) -> (GetStateValidityResponse, Option<String>) {
+    pub(crate) fn check_validity(&self, req: &GetStateValidityRequest) -> (GetStateValidityResponse, Option<String>) {
         self.validity_job(req).run()
     }
 }
@@ -189,18 +189,19 @@ fn refused() -> GetStateValidityResponse {
 
 impl ValidityJob {
     /// Why the request is refused before any check, if it is.
-    pub fn refused(&self) -> Option<&str> {
+    pub(crate) fn refused(&self) -> Option<&str> {
         self.plan.as_ref().err().map(String::as_str)
     }
 
-    /// A warning for the log (an unknown group checked as the whole robot).
-    pub fn warning(&self) -> Option<&str> {
+    /// A warning for the node's log (an unknown group checked as the whole robot).
+    #[cfg(feature = "ros")]
+    pub(crate) fn warning(&self) -> Option<&str> {
         self.warning.as_deref()
     }
 
     /// Checks the state (discrete): the response, and why the request could not be honoured
     /// (refused, or the check failed).
-    pub fn run(&self) -> (GetStateValidityResponse, Option<String>) {
+    pub(crate) fn run(&self) -> (GetStateValidityResponse, Option<String>) {
         let plan = match &self.plan {
             Ok(plan) => plan,
             Err(e) => return (refused(), Some(e.clone())),

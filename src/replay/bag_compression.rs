@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// At most this many decompressed bytes, over all files of a file-compressed bag (16 GiB): a bag
 /// larger than that is better decompressed once by hand than on every replay.
-pub const MAX_FILE_BYTES: u64 = 16 << 30;
+pub(crate) const MAX_FILE_BYTES: u64 = 16 << 30;
 
 /// The zstd frame magic number (little endian on disk).
 const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];

@@ -16,7 +16,8 @@
 use super::bag_compression::{compression_from_metadata, decompress_message, message_context, Compression, MessageContext, Scratch, MAX_FILE_BYTES};
 use super::bag_mcap::{mcap_topics, McapStream};
 use super::bag_sqlite::{sqlite_topics, SqliteStream};
-pub use super::bag_types::{BagError, BagMessage, MAX_RECORD_BYTES};
+use super::bag_types::MAX_RECORD_BYTES;
+pub use super::bag_types::{BagError, BagMessage};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 

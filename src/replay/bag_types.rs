@@ -5,17 +5,17 @@ use std::path::{Path, PathBuf};
 /// The longest record (MCAP) or message (sqlite3) this reader accepts: 256 MiB. A longer one is a
 /// corrupt length, or a message this replay has no use for; either way an error naming the file
 /// and the length, not an allocation of that size.
-pub const MAX_RECORD_BYTES: usize = 256 << 20;
+pub(crate) const MAX_RECORD_BYTES: usize = 256 << 20;
 /// Bytes asked of the file at a time (the MCAP reader's buffer grows by at most this much more
 /// than the data it holds).
 pub(super) const READ_PIECE: usize = 256 << 10;
 /// The `BufReader` over an MCAP file.
 pub(super) const FILE_BUFFER: usize = 64 << 10;
 /// Messages queued between the sqlite3 reader thread and the iterator.
-pub const SQLITE_QUEUE: usize = 256;
+pub(crate) const SQLITE_QUEUE: usize = 256;
 /// Payload bytes queued between the sqlite3 reader thread and the iterator (one larger message
 /// still passes, alone).
-pub const SQLITE_QUEUE_BYTES: usize = 16 << 20;
+pub(crate) const SQLITE_QUEUE_BYTES: usize = 16 << 20;
 
 /// One recorded message.
 #[derive(Clone, Debug)]

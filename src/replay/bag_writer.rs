@@ -16,7 +16,7 @@ const LATCHED_QOS: &str = "- history: 3\n  depth: 0\n  reliability: 1\n  durabil
 
 /// A topic of a [`BagWriter`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct TopicId(usize);
+pub(crate) struct TopicId(usize);
 
 struct TopicEntry {
     name: String,
@@ -27,7 +27,7 @@ struct TopicEntry {
 }
 
 /// Writes messages on a few topics into a new rosbag2 MCAP bag.
-pub struct BagWriter {
+pub(crate) struct BagWriter {
     dir: PathBuf,
     file_name: String,
     writer: mcap::Writer<BufWriter<std::fs::File>>,
@@ -41,7 +41,7 @@ pub struct BagWriter {
 
 impl BagWriter {
     /// Creates `dir`, which must not exist yet (as `ros2 bag record -o` requires).
-    pub fn create(dir: &Path) -> Result<BagWriter, OutputError> {
+    pub(crate) fn create(dir: &Path) -> Result<BagWriter, OutputError> {
         if dir.exists() {
             return Err(OutputError::Exists(dir.to_owned()));
         }
@@ -56,7 +56,7 @@ impl BagWriter {
 
     /// Adds a topic of a type this crate has the full definition of (`crate::msgs::full_definition`);
     /// `latched` records it as offered transient local.
-    pub fn add_topic(&mut self, topic: &str, type_name: &'static str, latched: bool) -> Result<TopicId, OutputError> {
+    pub(crate) fn add_topic(&mut self, topic: &str, type_name: &'static str, latched: bool) -> Result<TopicId, OutputError> {
         let schema = match self.schemas.get(type_name) {
             Some(id) => *id,
             None => {
@@ -75,7 +75,7 @@ impl BagWriter {
     }
 
     /// Appends one message received at `log_time` (nanoseconds).
-    pub fn write<T: Serialize>(&mut self, topic: TopicId, msg: &T, log_time: i64) -> Result<(), OutputError> {
+    pub(crate) fn write<T: Serialize>(&mut self, topic: TopicId, msg: &T, log_time: i64) -> Result<(), OutputError> {
         let mut buf = std::mem::take(&mut self.buf);
         encode_cdr_le_into(&mut buf, msg);
         let written = self.write_raw(topic, &buf, log_time);
@@ -94,7 +94,7 @@ impl BagWriter {
     }
 
     /// Appends one message already in CDR (with its encapsulation header), as copied from a bag.
-    pub fn write_raw(&mut self, topic: TopicId, data: &[u8], log_time: i64) -> Result<(), OutputError> {
+    pub(crate) fn write_raw(&mut self, topic: TopicId, data: &[u8], log_time: i64) -> Result<(), OutputError> {
         let entry = &mut self.topics[topic.0];
         // MCAP sequence numbers are 32 bits and may wrap; readers order by log time.
         let header =
@@ -107,7 +107,7 @@ impl BagWriter {
     }
 
     /// Finishes the MCAP file and writes `metadata.yaml`.
-    pub fn finish(mut self) -> Result<PathBuf, OutputError> {
+    pub(crate) fn finish(mut self) -> Result<PathBuf, OutputError> {
         let _ = self.writer.finish()?;
         let start = self.first.unwrap_or(0);
         let duration = self.last - start;

@@ -46,7 +46,7 @@ pub fn encode_cdr_le<T: Serialize>(msg: &T) -> Vec<u8> {
 
 /// As [`encode_cdr_le`], into `out` (cleared first): a writer that reuses one buffer allocates
 /// nothing per message.
-pub fn encode_cdr_le_into<T: Serialize>(out: &mut Vec<u8>, msg: &T) {
+pub(crate) fn encode_cdr_le_into<T: Serialize>(out: &mut Vec<u8>, msg: &T) {
     out.clear();
     out.extend_from_slice(&[0x00, 0x01, 0x00, 0x00]);
     // Alignment counts from the first byte the serialiser writes, after the header, as CDR wants.

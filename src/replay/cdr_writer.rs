@@ -7,13 +7,13 @@ use crate::msgs::{ColorRgba, Header, Marker, MarkerArray, Point, TfMessage};
 
 /// A message being encoded: the 4-byte encapsulation header, then the payload. Alignment counts
 /// from the payload's first byte, as CDR wants.
-pub struct CdrWriter<'a> {
+pub(crate) struct CdrWriter<'a> {
     buf: &'a mut Vec<u8>,
 }
 
 impl<'a> CdrWriter<'a> {
     /// Starts a message in `buf` (cleared).
-    pub fn new(buf: &'a mut Vec<u8>) -> CdrWriter<'a> {
+    pub(crate) fn new(buf: &'a mut Vec<u8>) -> CdrWriter<'a> {
         buf.clear();
         buf.extend_from_slice(&[0x00, 0x01, 0x00, 0x00]);
         CdrWriter { buf }
@@ -83,7 +83,7 @@ impl<'a> CdrWriter<'a> {
     }
 
     /// `tf2_msgs/TFMessage`.
-    pub fn tf_message(mut self, m: &TfMessage) {
+    pub(crate) fn tf_message(mut self, m: &TfMessage) {
         self.len(m.transforms.len());
         for t in &m.transforms {
             self.header(&t.header);
@@ -94,7 +94,7 @@ impl<'a> CdrWriter<'a> {
     }
 
     /// `visualization_msgs/MarkerArray` (the Iron/Jazzy `Marker`).
-    pub fn marker_array(mut self, a: &MarkerArray) {
+    pub(crate) fn marker_array(mut self, a: &MarkerArray) {
         self.len(a.markers.len());
         for m in &a.markers {
             self.marker(m);

@@ -30,11 +30,11 @@ pub(super) struct FirstWarnings<'a> {
 }
 
 impl<'a> FirstWarnings<'a> {
-    pub fn new(observer: &'a mut dyn ReplayObserver) -> Self {
+    pub(crate) fn new(observer: &'a mut dyn ReplayObserver) -> Self {
         FirstWarnings { seen: HashSet::new(), observer }
     }
 
-    pub fn warn(&mut self, kind: &str, message: impl FnOnce() -> String) {
+    pub(crate) fn warn(&mut self, kind: &str, message: impl FnOnce() -> String) {
         if self.seen.insert(kind.to_owned()) {
             self.observer.warning(&format!("{} (further ones are counted, not printed)", message()));
         }

@@ -11,7 +11,7 @@ const MAX_BARS_KEPT: usize = 8192;
 
 /// One link's run of consecutive colliding reports (or several merged).
 #[derive(Clone, Debug, PartialEq)]
-pub struct TimelineBar {
+pub(crate) struct TimelineBar {
     /// Seconds from the bag's first message to the first colliding report of the run.
     pub start: f64,
     /// Seconds from the bag's first message to its last colliding report.
@@ -34,12 +34,12 @@ pub struct TimelineBar {
 
 impl TimelineBar {
     /// No state in it collides: only the motions into them do.
-    pub fn motion_only(&self) -> bool {
+    pub(crate) fn motion_only(&self) -> bool {
         !self.state_hit
     }
 
     /// Takes `next` (later) into this bar.
-    pub fn absorb(&mut self, next: &TimelineBar) {
+    pub(crate) fn absorb(&mut self, next: &TimelineBar) {
         self.end = next.end;
         self.states.1 = next.states.1;
         self.colliding += next.colliding;
@@ -54,7 +54,7 @@ impl TimelineBar {
 /// flickering contact makes a bar every few reports, and a heap node per bar (a `BTreeSet` of
 /// names, as it was) slowed every allocation of the replay loop by a fifth (docs/benchmarks.md).
 #[derive(Clone, Debug, PartialEq)]
-pub enum BarObjects {
+pub(crate) enum BarObjects {
     One(u32),
     Many(BTreeSet<u32>),
 }
@@ -78,7 +78,7 @@ impl BarObjects {
     }
 
     /// The numbers, ascending.
-    pub fn ids(&self) -> Vec<u32> {
+    pub(crate) fn ids(&self) -> Vec<u32> {
         match self {
             BarObjects::One(o) => vec![*o],
             BarObjects::Many(set) => set.iter().copied().collect(),
@@ -88,7 +88,7 @@ impl BarObjects {
 
 /// One row of the picture.
 #[derive(Clone, Debug)]
-pub struct TimelineRow {
+pub(crate) struct TimelineRow {
     /// The link.
     pub link: String,
     /// Its bars, in time order.
@@ -98,11 +98,11 @@ pub struct TimelineRow {
 }
 
 /// The deepest contact of the replay: (seconds, report number, link, object, depth).
-pub type TimelineDeepest = (f64, usize, String, String, f64);
+pub(crate) type TimelineDeepest = (f64, usize, String, String, f64);
 
 /// Everything the picture shows, gathered report by report.
 #[derive(Clone, Debug, Default)]
-pub struct Timeline {
+pub(crate) struct Timeline {
     /// Rows in the order their links first collided.
     pub rows: Vec<TimelineRow>,
     /// Reports recorded.
@@ -123,7 +123,7 @@ impl Timeline {
     /// motion in collision where some colliding link has no state hit in its run yet. A run
     /// known to hit at a state stays so, so a long contact costs one second check, not one per
     /// report.
-    pub fn needs_state_check(&self, report: &StateReport) -> bool {
+    pub(crate) fn needs_state_check(&self, report: &StateReport) -> bool {
         let n = self.reports + 1;
         report.motion
             && report.in_collision
@@ -134,7 +134,7 @@ impl Timeline {
     }
 
     /// The names of a bar's objects, sorted.
-    pub fn object_names(&self, bar: &TimelineBar) -> Vec<&str> {
+    pub(crate) fn object_names(&self, bar: &TimelineBar) -> Vec<&str> {
         let mut names: Vec<&str> = bar.objects.ids().into_iter().filter_map(|id| self.objects.get(id as usize).map(String::as_str)).collect();
         names.sort_unstable();
         names
@@ -151,14 +151,14 @@ impl Timeline {
     }
 
     /// Motion-only runs (bars) in the picture's rows.
-    pub fn motion_only_runs(&self) -> usize {
+    pub(crate) fn motion_only_runs(&self) -> usize {
         self.rows.iter().flat_map(|r| &r.bars).filter(|b| b.motion_only()).count()
     }
 
     /// Records the next report, made `seconds` after the bag's first message. `state_links`: the
     /// links that collide at the reported state itself, when [`Timeline::needs_state_check`] asked
     /// for them (`None`: every colliding link counts as a state hit).
-    pub fn record(&mut self, seconds: f64, report: &StateReport, state_links: Option<&HashSet<String>>) {
+    pub(crate) fn record(&mut self, seconds: f64, report: &StateReport, state_links: Option<&HashSet<String>>) {
         self.reports += 1;
         self.last_seconds = seconds;
         let n = self.reports;
@@ -234,7 +234,7 @@ impl TimelineRow {
 
 /// Merges each bar into the one before it while `close(before, bar)`, within the vector (which
 /// keeps its block: a row's bars are merged again and again while a bag streams).
-pub fn merge_bars(bars: &mut Vec<TimelineBar>, close: impl Fn(&TimelineBar, &TimelineBar) -> bool) {
+pub(crate) fn merge_bars(bars: &mut Vec<TimelineBar>, close: impl Fn(&TimelineBar, &TimelineBar) -> bool) {
     let mut kept = 0;
     for i in 0..bars.len() {
         if kept > 0 && close(&bars[kept - 1], &bars[i]) {

@@ -29,7 +29,7 @@ struct DrawnBar {
 }
 
 /// The picture of `timeline` for the bag named `bag`.
-pub fn timeline_svg(timeline: &Timeline, bag: &str) -> Result<String, super::output_error::OutputError> {
+pub(crate) fn timeline_svg(timeline: &Timeline, bag: &str) -> Result<String, super::output_error::OutputError> {
     let rows = timeline.rows.len().max(1) as u32;
     let height = HEADER + rows * ROW + FOOTER;
     let mut svg = String::new();

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 /// [`DescriptionMsg::TooLarge`] (to be refused with the bound in the error), so a 50 MB
 /// description costs the node its sample, never a second copy.
 #[derive(Clone, Debug, PartialEq)]
-pub enum DescriptionMsg {
+pub(crate) enum DescriptionMsg {
     /// URDF text within the bound.
     Text(String),
     /// Text of this many bytes, past the bound.

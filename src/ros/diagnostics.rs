@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 /// Counters the node keeps for `/diagnostics` (skips are counted by the pipeline).
 #[derive(Default)]
-pub struct NodeStats {
+pub(crate) struct NodeStats {
     /// Input messages received since start (states, `/tf`).
     pub received: u64,
     /// States checked since start.
@@ -30,7 +30,7 @@ pub struct NodeStats {
 impl NodeStats {
     /// Counts one check that took `seconds` and covered `states` states (a motion report covers
     /// every state that waited for it).
-    pub fn record_check(&mut self, seconds: f64, states: u64) {
+    pub(crate) fn record_check(&mut self, seconds: f64, states: u64) {
         self.checked += states;
         self.window_checks += 1;
         self.check_sum += seconds;
@@ -47,7 +47,7 @@ const ERROR: u8 = 2;
 /// skip other than a stale one (a bad or foreign message) raises the level to WARN; a refused
 /// `robot_description` (`description_error`, until a good one arrives) to ERROR, with its error
 /// line as the message: the node is checking a robot other than the one described.
-pub fn diagnostics(
+pub(crate) fn diagnostics(
     node: &str,
     stats: &mut NodeStats,
     skipped: &BTreeMap<SkipCause, u64>,

@@ -27,7 +27,7 @@ use ros2_client::{Name, Node, QosProfile, ReadResult, Server, ServiceMapping, Se
 use std::pin::Pin;
 
 /// One request to any of the six services.
-pub enum ParamRequest {
+pub(crate) enum ParamRequest {
     /// `get_parameters`.
     Get(RmwRequestId, GetParametersRequest),
     /// `get_parameter_types`.
@@ -43,7 +43,7 @@ pub enum ParamRequest {
 }
 
 /// The six servers.
-pub struct ParamServers {
+pub(crate) struct ParamServers {
     get: Server<GetParametersRequest, GetParametersResponse>,
     get_types: Server<GetParameterTypesRequest, GetParameterTypesResponse>,
     set: Server<SetParametersRequest, SetParametersResponse>,
@@ -53,15 +53,15 @@ pub struct ParamServers {
 }
 
 /// Every request of the six services, in arrival order per service.
-pub type ParamRequests<'a> = Pin<Box<dyn FusedStream<Item = ReadResult<ParamRequest>> + 'a>>;
+pub(crate) type ParamRequests<'a> = Pin<Box<dyn FusedStream<Item = ReadResult<ParamRequest>> + 'a>>;
 
 /// Whether ros2-client serves the parameter services itself (only with the enhanced mapping).
-pub fn served_by_ros2_client(mapping: ServiceMapping) -> bool {
+pub(crate) fn served_by_ros2_client(mapping: ServiceMapping) -> bool {
     mapping == ServiceMapping::Enhanced
 }
 
 /// The node's `service_mapping` parameter as ros2-client's mapping.
-pub fn ros_mapping(mapping: crate::model::ServiceMapping) -> ServiceMapping {
+pub(crate) fn ros_mapping(mapping: crate::model::ServiceMapping) -> ServiceMapping {
     match mapping {
         crate::model::ServiceMapping::Enhanced => ServiceMapping::Enhanced,
         crate::model::ServiceMapping::Basic => ServiceMapping::Basic,
@@ -72,7 +72,7 @@ pub fn ros_mapping(mapping: crate::model::ServiceMapping) -> ServiceMapping {
 impl ParamServers {
     /// The servers under the node's name (`<node>/get_parameters`, ...) with `mapping`; `None`
     /// when ros2-client serves them (the enhanced mapping).
-    pub fn build(node: &mut Node, mapping: ServiceMapping) -> Result<Option<ParamServers>> {
+    pub(crate) fn build(node: &mut Node, mapping: ServiceMapping) -> Result<Option<ParamServers>> {
         if served_by_ros2_client(mapping) {
             return Ok(None);
         }
@@ -99,7 +99,7 @@ impl ParamServers {
     }
 
     /// The requests of all six services as one stream (never ends while the servers live).
-    pub fn requests(&self) -> ParamRequests<'_> {
+    pub(crate) fn requests(&self) -> ParamRequests<'_> {
         let streams: Vec<Pin<Box<dyn futures::Stream<Item = ReadResult<ParamRequest>> + '_>>> = vec![
             Box::pin(self.get.receive_request_stream().map(|r| r.map(|(id, q)| ParamRequest::Get(id, q)))),
             Box::pin(self.get_types.receive_request_stream().map(|r| r.map(|(id, q)| ParamRequest::GetTypes(id, q)))),

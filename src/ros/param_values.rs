@@ -7,11 +7,11 @@ use serde_json::Value;
 use std::sync::{Arc, Mutex};
 
 /// Parameters that shape the node's topics and services, fixed once they are created.
-pub const READ_ONLY: [&str; 3] = ["pose_source", "service_mapping", "use_sim_time"];
+pub(crate) const READ_ONLY: [&str; 3] = ["pose_source", "service_mapping", "use_sim_time"];
 
 /// Every parameter with its ROS 2 value. An empty list takes its element type from
 /// [`Params::array_kinds`] (JSON cannot tell an empty list of numbers from one of strings).
-pub fn declarations(params: &Params) -> Vec<(String, ParameterValue)> {
+pub(crate) fn declarations(params: &Params) -> Vec<(String, ParameterValue)> {
     let kinds = Params::array_kinds();
     params
         .flat()
@@ -42,7 +42,7 @@ fn to_parameter(v: &Value) -> ParameterValue {
 }
 
 /// A parameter value as JSON, for [`Params::with_value`] (which checks its type).
-pub fn to_json(value: &ParameterValue) -> Value {
+pub(crate) fn to_json(value: &ParameterValue) -> Value {
     let num = |x: f64| serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number);
     match value {
         ParameterValue::NotSet => Value::Null,
@@ -60,7 +60,7 @@ pub fn to_json(value: &ParameterValue) -> Value {
 
 /// The node's options: its parameters declared, and where accepted changes go: the
 /// set-parameters service only validates (it runs in the spinner's task); the loop rebuilds.
-pub fn parameter_options(params: &Params, changes: smol::channel::Sender<Params>) -> NodeOptions {
+pub(crate) fn parameter_options(params: &Params, changes: smol::channel::Sender<Params>) -> NodeOptions {
     let accepted = Arc::new(Mutex::new(params.clone()));
     let action = move |name: &str, value: &ParameterValue| -> Result<(), String> {
         let mut current = accepted.lock().map_err(|_| "parameter state poisoned".to_string())?;

@@ -7,11 +7,11 @@ use std::path::Path;
 use std::sync::{Mutex, OnceLock};
 use thickness_collision::math::Vector;
 use thickness_collision::mesh::{MeshTopology, TopologySettings};
-use thickness_collision::model::mesh_file::parse_mesh;
+use thickness_collision::fuzz_access::{open_bag, parse_mesh, PipelineAccess};
 use thickness_collision::model::{Params, Srdf};
 use thickness_collision::msgs::{CheckStatesRequest, ClockMsg, JointState, StringMsg, TfMessage};
 use thickness_collision::pipeline::{parse_state_line, Pipeline, RobotState};
-use thickness_collision::replay::{decode_cdr, open_bag};
+use thickness_collision::replay::decode_cdr;
 use thickness_collision::thickness::{ThicknessArea, ThicknessSettings};
 
 /// SRDF text (a `robot_semantic_file` or a `robot_description_semantic` message) parsed against

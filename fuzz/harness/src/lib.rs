@@ -1,7 +1,9 @@
 //! The fuzz targets' entry points, one function per target, shared by the `cargo fuzz` crate in
 //! `fuzz/` and by the main crate's `tests/fuzz_regressions.rs`, which replays every saved input on
 //! stable: a crash the fuzzer found stays found by `cargo test`. A crate of its own so the library
-//! carries none of it; it calls the library's public API only.
+//! carries none of it; it calls the library's public API, and `thickness_collision::fuzz_access`
+//! (hidden, not API) for the steps it fuzzes alone: the mesh parsers behind their guards, the bag
+//! reader, the node's request services.
 //!
 //! Every entry takes raw bytes and must never panic, abort or hang, whatever the bytes. Each goes
 //! as deep as the front door it stands for: URDF text is loaded and the robot checked in a few

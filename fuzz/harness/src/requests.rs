@@ -2,7 +2,7 @@
 //! with the invariants every answer must keep.
 
 use crate::fixtures::{fresh_pipeline_with_one_joint, workcell};
-use thickness_collision::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
+use thickness_collision::fuzz_access::{GetStateValidityRequest, GetStateValidityResponse, PipelineAccess};
 use thickness_collision::msgs::CheckTrajectoryRequest;
 use thickness_collision::replay::decode_cdr;
 

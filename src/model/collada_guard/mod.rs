@@ -43,7 +43,7 @@ const MAX_QUOTED: usize = 40;
 /// Checks `bytes` (a `.dae` file) for what makes mesh-loader 0.1.13 panic, loop or allocate
 /// without bound. `Err` is one line: the line of the file, the element, the attribute and its
 /// value, and what is allowed. Files mesh-loader refuses with an error of its own may pass.
-pub fn check_collada(bytes: &[u8]) -> Result<(), String> {
+pub(crate) fn check_collada(bytes: &[u8]) -> Result<(), String> {
     let text = decode(bytes)?;
     let doc = Document::parse(&text).map_err(|e| format!("not well-formed XML: {e}"))?;
     let root = doc.root_element();
