@@ -24,7 +24,7 @@ use parry3d_f64::math::Matrix;
 const LEAF_CELLS: usize = 32;
 
 // A leaf's support queries are made in one call (see `scene::deepest_search`).
-const _: () = assert!(LEAF_CELLS <= super::target::MANY);
+const _: () = assert!(LEAF_CELLS <= super::convex_hull::MANY);
 
 /// Slack when a node's slab is compared with the target: rounding must never prune a node whose
 /// cells the exact per-cell test would keep.

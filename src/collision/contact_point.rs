@@ -7,7 +7,7 @@
 //! to the capsule segment (or a point of the segment inside the cell).
 
 use super::polytope::CellPolytope;
-use super::target::ConvexHull;
+use super::convex_hull::ConvexHull;
 use crate::math::{Real, Vector};
 
 /// The point of `hull ∩ cell` deepest along `-normal` (averaged over ties), or `None` if the

@@ -18,6 +18,7 @@
 mod cell_contact;
 mod cell_tree;
 mod contact_point;
+mod convex_hull;
 mod gjk;
 mod pair;
 mod polytope;
@@ -33,4 +34,5 @@ pub use self::pair::{collide_pair, pair_may_meet, PairContact};
 pub use self::report::{CollideSettings, Contact, LeastOverlap, TargetReport};
 pub use self::scene::{ObjectBody, Scene, SceneObject};
 pub use self::scene_clearance::Clearance;
-pub use self::target::{ConvexHull, Target, TargetShape};
+pub use self::convex_hull::ConvexHull;
+pub use self::target::{Target, TargetShape};
