@@ -259,7 +259,7 @@ impl CellTree {
     }
 
     /// Whether a cell's box, seen from the target's frame, meets the target's own box.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn slab_meets_target_box(slab: &CellSlab, view: &TargetView) -> bool {
         view.meets_own_box(slab.centre(), slab.half())
     }

@@ -25,6 +25,7 @@ pub(crate) trait CellVisitor {
 }
 
 /// Depth first from the root, the child with the larger key first.
+#[inline(always)]
 pub(crate) fn walk(tree: &CellTree, view: &TargetView, visitor: &mut impl CellVisitor) -> ControlFlow<()> {
     if tree.is_empty() {
         return ControlFlow::Continue(());

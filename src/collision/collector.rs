@@ -87,7 +87,9 @@ impl Collector for AnyHit {
             first = Some(hit);
             ControlFlow::Break(())
         };
-        let _ = walk(tree, view, &mut EachHit::new(area, &mut self.report.candidates, self.least_overlap, &mut stop_at_first));
+        let mut search = EachHit::new(area, self.least_overlap, &mut stop_at_first);
+        let _ = walk(tree, view, &mut search);
+        self.report.candidates += search.candidates;
         let Some(hit) = first else {
             return ControlFlow::Continue(());
         };
@@ -117,14 +119,12 @@ impl Collector for AllHits {
         let report = &mut self.report;
         let before = report.contacts.len();
         let contacts = &mut report.contacts;
-        let _ = walk(
-            tree,
-            view,
-            &mut EachHit::new(area, &mut report.candidates, true, |hit| {
-                contacts.push(cell_contact_with_point(object, area, view, &hit));
-                ControlFlow::Continue(())
-            }),
-        );
+        let mut search = EachHit::new(area, true, |hit| {
+            contacts.push(cell_contact_with_point(object, area, view, &hit));
+            ControlFlow::Continue(())
+        });
+        let _ = walk(tree, view, &mut search);
+        report.candidates += search.candidates;
         if report.contacts.len() > before {
             report.objects.push(object);
         }
