@@ -1,10 +1,11 @@
 //! One target against one cell: the SAT, then what is reported for a colliding pair.
 
-use super::cell_tree::{CellSlab, TargetView};
+use super::cell_slab::CellSlab;
 use super::contact_point::{closest_on_cell, contact_capsule_cell, contact_cylinder_cell, contact_hull_cell};
 use super::polytope::CellPolytope;
 use super::sat::{sat_capsule_cell, sat_hull_cell, sat_sphere_cell, SatOverlap};
 use super::target::{Target, TargetShape};
+use super::target_view::TargetView;
 use crate::math::{Pose, Real, Rotation, Vector};
 use crate::thickness::{Side, ThicknessCell};
 use parry3d_f64::math::Matrix;

@@ -15,16 +15,16 @@
 //! overlapping), 32 beat 16 by 4 % (two trees in one process, runs interleaved), and 48 was no
 //! better.
 
-use super::target::Target;
-use crate::math::{Aabb, Pose, Real, Vector};
+use super::cell_slab::{cell_box, f32_above, CellSlab, LeafView};
+use super::target_view::TargetView;
+use crate::math::{Aabb, Real, Vector};
 use crate::thickness::{Side, ThicknessCell};
-use parry3d_f64::math::Matrix;
 
 /// Cells per leaf.
 const LEAF_CELLS: usize = 32;
 
 // A leaf's support queries are made in one call (see `scene::deepest_search`).
-const _: () = assert!(LEAF_CELLS <= super::target::MANY);
+const _: () = assert!(LEAF_CELLS <= super::convex_hull::MANY);
 
 /// Slack when a node's slab is compared with the target: rounding must never prune a node whose
 /// cells the exact per-cell test would keep.
@@ -57,220 +57,12 @@ impl CellNode {
     }
 }
 
-/// What the cheap first tests of a cell (its box, its normal axis) read, kept beside the tree in
-/// leaf order: a leaf's cells are then one contiguous read, where the cells themselves (328 bytes
-/// each, in input order) would cost a cache miss each on a large surface. 80 bytes: the box and
-/// the tilt, which only ever prune, are single precision, rounded outwards (at 1M cells the
-/// search streams these from memory, and 104 bytes in double precision were a quarter more).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct CellSlab {
-    /// The face's front normal.
-    pub normal: Vector,
-    /// `[min, max]` of `normal . x` over the cell.
-    pub range: [Real; 2],
-    /// `normal . x` on the face.
-    pub plane_offset: Real,
-    /// The centre and half extents of a box holding the cell's bounding box.
-    centre: [f32; 3],
-    half: [f32; 3],
-    /// At least `|normal - axis|` for the cone axis of the cell's leaf (0 outside a tree).
-    tilt: f32,
-}
-
-/// `x` rounded to single precision, then pushed up by more than the rounding.
-fn f32_above(x: Real) -> f32 {
-    ((x.abs() * (1.0 + 1e-6) + 1e-12) as f32).max(0.0)
-}
-
-impl CellSlab {
-    pub fn of(cell: &ThicknessCell) -> CellSlab {
-        let (lo, hi) = cell_box(cell);
-        let (c, h) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
-        let centre = c.to_array().map(|x| x as f32);
-        // The half extents grow by the centre's rounding error, so the box still holds the cell.
-        let half = std::array::from_fn(|k| f32_above(h[k] + (c[k] - centre[k] as Real).abs()));
-        CellSlab { normal: cell.normal, range: cell.normal_range(), plane_offset: cell.plane_offset, centre, half, tilt: 0.0 }
-    }
-
-    /// The centre of the cell's (slightly grown) box.
-    #[inline]
-    pub fn centre(&self) -> Vector {
-        Vector::new(self.centre[0] as Real, self.centre[1] as Real, self.centre[2] as Real)
-    }
-
-    /// The half extents of the cell's (slightly grown) box.
-    #[inline]
-    pub fn half(&self) -> Vector {
-        Vector::new(self.half[0] as Real, self.half[1] as Real, self.half[2] as Real)
-    }
-
-    /// An upper bound on the depth this cell reports against the target of `leaf`, from the
-    /// leaf's projection of the target on its cone axis (see [`LeafView`]): with `n` the cell's
-    /// normal, `m` the axis and `c` the target's centre, `n . x = m . x + (n - m) . c + (n - m) .
-    /// (x - c)`, so `min n . x >= min m . x + (n - m) . c - tilt * radius`. A cell whose bound
-    /// cannot beat the deepest contact found needs no support query of its own.
-    #[inline]
-    pub fn depth_bound(&self, leaf: &LeafView) -> Real {
-        let shift = self.normal.dot(leaf.centre) - leaf.axis_centre;
-        let slack = self.tilt as Real * leaf.radius;
-        let back = self.range[1] - leaf.extent[0] + slack - shift;
-        let front = leaf.extent[1] + slack + shift - self.range[0];
-        match leaf.side {
-            Side::Back => back,
-            Side::Front => front,
-            Side::Both => back.max(front),
-        }
-    }
-}
-
-/// A target seen from one leaf: what [`CellSlab::depth_bound`] needs (surface frame).
-pub(crate) struct LeafView {
-    /// `[min, max]` of `axis . x` over the target.
-    extent: [Real; 2],
-    /// The target's centre, and `axis . centre`.
-    centre: Vector,
-    axis_centre: Real,
-    radius: Real,
-    side: Side,
-}
-
 /// The tree over one surface's cells, in the surface's frame.
 #[derive(Clone, Debug, Default)]
 pub struct CellTree {
     nodes: Vec<CellNode>,
     /// The cells' normal slabs in leaf order.
     slabs: Vec<CellSlab>,
-}
-
-/// A target seen from a surface's frame, with what the node tests need.
-pub(crate) struct TargetView<'a> {
-    pub target: &'a Target,
-    /// The pose of the surface's frame in the target's frame.
-    pub object_in_target: Pose,
-    /// The target's bounding box in the surface's frame.
-    pub aabb: Aabb,
-    /// The target's bounding box in its own frame, and the rotation part of `object_in_target`
-    /// as a matrix and with its entries made positive: a node's box seen from the target.
-    local_aabb: Aabb,
-    pub rotation: Matrix,
-    rotation_abs: Matrix,
-    /// The target's centre in the surface's frame.
-    pub centre: Vector,
-    /// Radius of a ball about `centre` that holds the target.
-    radius: Real,
-    side: Side,
-}
-
-impl<'a> TargetView<'a> {
-    /// `world_aabb` is the target's exact box in the world.
-    pub fn new(target: &'a Target, object_pose: &Pose, side: Side, world_aabb: &Aabb) -> Self {
-        let target_in_object = object_pose.inv_mul(&target.pose);
-        let object_in_target = target_in_object.inverse();
-        let rotation = Matrix::from_quat(object_in_target.rotation);
-        // Walls, shelves and tables usually stand square to the world: then the world box, turned
-        // into the surface's frame, is the exact box there too (to rounding), and the six support
-        // queries of an exact box are saved.
-        let square = Matrix::from_quat(object_pose.rotation).abs();
-        let aabb = if [square.row(0), square.row(1), square.row(2)].iter().all(|r| r.max_element() > 1.0 - 1e-12 && r.element_sum() < 1.0 + 1e-9) {
-            transformed_box(world_aabb, &object_pose.inverse())
-        } else {
-            target.aabb_in(&target_in_object)
-        };
-        TargetView {
-            target,
-            object_in_target,
-            local_aabb: target.shape.local_aabb(),
-            rotation,
-            rotation_abs: rotation.abs(),
-            aabb,
-            centre: target_in_object * target.shape.centre(),
-            radius: target.shape.bounding_radius(),
-            side,
-        }
-    }
-
-    /// Whether a box of the surface's frame (centre, half extents), seen from the target's frame,
-    /// meets the target's own bounding box (touching counts; a NaN does not).
-    #[inline]
-    pub fn meets_own_box(&self, centre: Vector, half: Vector) -> bool {
-        let c = self.rotation * centre + self.object_in_target.translation;
-        let h = self.rotation_abs * half;
-        let b = &self.local_aabb;
-        (c - h).cmple(b.maxs).all() && b.mins.cmple(c + h).all()
-    }
-
-    /// A lower bound on the distance from the target to anything in a box of the surface's frame
-    /// (centre, half extents): the gap between that box, seen from the target's frame, and the
-    /// target's own bounding box (0 when they meet).
-    #[inline]
-    pub fn own_box_gap(&self, centre: Vector, half: Vector) -> Real {
-        let c = self.rotation * centre + self.object_in_target.translation;
-        let h = self.rotation_abs * half;
-        let b = &self.local_aabb;
-        let gap = (b.mins - (c + h)).max(c - h - b.maxs).max(Vector::ZERO);
-        gap.length()
-    }
-
-    /// `[min, max]` of `dir . x` over the target where the surface's side makes it a depth (the
-    /// minimum for `back`, the maximum for `front`, both for `both`), and the other end from the
-    /// target's own box (outside the exact extent): one support query where two were.
-    #[inline]
-    pub fn depth_extent_along(&self, dir: Vector) -> [Real; 2] {
-        let (d, query) = self.depth_query(dir);
-        self.depth_extent_from(d, query.map_or(0.0, |q| self.target.shape.support(q)))
-    }
-
-    /// `dir` in the target's frame, and the one support query [`TargetView::depth_extent_along`]
-    /// makes: along it negated for `back` (its support gives the minimum), along it for `front`,
-    /// none for `both` (both ends are queried in [`TargetView::depth_extent_from`]).
-    #[inline]
-    pub fn depth_query(&self, dir: Vector) -> (Vector, Option<Vector>) {
-        let d = self.rotation * dir;
-        let query = match self.side {
-            Side::Back => Some(-d),
-            Side::Front => Some(d),
-            Side::Both => None,
-        };
-        (d, query)
-    }
-
-    /// [`TargetView::depth_extent_along`] for `d`, the direction already in the target's frame,
-    /// given the support along [`TargetView::depth_query`] (unused for `both`, which queries
-    /// both ends here).
-    #[inline]
-    pub fn depth_extent_from(&self, d: Vector, support: Real) -> [Real; 2] {
-        let shift = d.dot(self.object_in_target.translation);
-        let b = &self.local_aabb;
-        let c = d.dot((b.mins + b.maxs) * 0.5);
-        let r = d.abs().dot((b.maxs - b.mins) * 0.5);
-        match self.side {
-            Side::Back => [-support - shift, c + r - shift],
-            Side::Front => [c - r - shift, support - shift],
-            Side::Both => self.target.shape.project(d).map(|x| x - shift),
-        }
-    }
-
-    /// `[min, max]` of `dir . x` over the target, for a direction in the surface's frame.
-    #[inline]
-    pub fn extent_along(&self, dir: Vector) -> [Real; 2] {
-        let d = self.rotation * dir;
-        let shift = d.dot(self.object_in_target.translation);
-        self.target.shape.project(d).map(|x| x - shift)
-    }
-}
-
-/// The box around a box of another frame (`pose` maps that frame into this one).
-pub(crate) fn transformed_box(local: &Aabb, pose: &Pose) -> Aabb {
-    let c = *pose * local.center();
-    let h = local.half_extents();
-    let m = Matrix::from_quat(pose.rotation).abs();
-    let e = Vector::new(m.row(0).dot(h), m.row(1).dot(h), m.row(2).dot(h));
-    Aabb::new(c - e, c + e)
-}
-
-fn cell_box(cell: &ThicknessCell) -> (Vector, Vector) {
-    let v = cell.vertices();
-    v.iter().fold((v[0], v[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
 }
 
 /// `max dir . x` over a box.
@@ -467,7 +259,7 @@ impl CellTree {
     }
 
     /// Whether a cell's box, seen from the target's frame, meets the target's own box.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn slab_meets_target_box(slab: &CellSlab, view: &TargetView) -> bool {
         view.meets_own_box(slab.centre(), slab.half())
     }

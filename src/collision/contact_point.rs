@@ -6,8 +6,8 @@
 //! in both shapes. For curved targets the point is the cell's closest point to the sphere centre or
 //! to the capsule segment (or a point of the segment inside the cell).
 
+use super::convex_hull::ConvexHull;
 use super::polytope::CellPolytope;
-use super::target::ConvexHull;
 use crate::math::{Real, Vector};
 
 /// The point of `hull ∩ cell` deepest along `-normal` (averaged over ties), or `None` if the

@@ -8,7 +8,7 @@
 //! Why: on a Panda link hull (150 vertices, 300 faces, 450 edges) a SAT that finds overlap tests
 //! every face and ~4,000 edge pairs; GJK needs a handful of support queries.
 
-use super::target::ConvexHull;
+use super::convex_hull::ConvexHull;
 use crate::math::{Real, Vector};
 
 /// How far inside the tetrahedron (metres) the origin must be for a "yes".

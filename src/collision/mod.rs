@@ -16,8 +16,13 @@
 //! is reported is in `report`.
 
 mod cell_contact;
+mod cell_search;
+mod cell_slab;
 mod cell_tree;
+mod cell_walk;
+mod collector;
 mod contact_point;
+mod convex_hull;
 mod gjk;
 mod pair;
 mod polytope;
@@ -26,11 +31,13 @@ mod sat;
 mod scene;
 mod scene_clearance;
 mod target;
+mod target_view;
 
 pub use self::cell_contact::{collide_target_cell, CellHit};
 pub use self::cell_tree::CellTree;
+pub use self::convex_hull::ConvexHull;
 pub use self::pair::{collide_pair, pair_may_meet, PairContact};
 pub use self::report::{CollideSettings, Contact, LeastOverlap, TargetReport};
 pub use self::scene::{ObjectBody, Scene, SceneObject};
 pub use self::scene_clearance::Clearance;
-pub use self::target::{ConvexHull, Target, TargetShape};
+pub use self::target::{Target, TargetShape};

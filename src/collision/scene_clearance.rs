@@ -1,6 +1,7 @@
 //! Clearance: the distance from a target to the nearest cell or solid within a threshold.
 //!
-//! The same cell tree that bounds depth per node bounds distance: a node's box is at least as far
+//! It is a collector on the scene's one walk (`collector`, `cell_walk`). The same cell tree that
+//! bounds depth per node bounds distance: a node's box is at least as far
 //! from the target as the target's bounding box (in the surface's frame) and its bounding ball
 //! are, and a subtree whose lower bound is not below the nearest distance found so far (at first
 //! the threshold) is pruned. Children are visited nearer bound first, so the first leaves reached
@@ -8,13 +9,17 @@
 //! exact distance from GJK (parry's, in f64, with this crate's hill-climbing support for hulls),
 //! which stops as soon as it proves the pair farther apart than the best so far.
 
-use super::cell_tree::TargetView;
-use super::scene::{ObjectBody, Scene};
+use super::cell_tree::CellTree;
+use super::cell_walk::{walk, CellVisitor};
+use super::collector::Collector;
+use super::scene::Scene;
 use super::target::{Target, TargetShape};
+use super::target_view::TargetView;
 use crate::math::{Aabb, Pose, Real, Vector};
-use parry3d_f64::bounding_volume::BoundingVolume;
+use crate::thickness::ThicknessArea;
 use parry3d_f64::query::gjk::{GJKResult, VoronoiSimplex};
 use parry3d_f64::shape::SupportMap;
+use std::ops::ControlFlow;
 
 /// The nearest cell or solid to a target, in the world frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -102,79 +107,87 @@ impl Scene {
         if !(threshold > 0.0) {
             return None;
         }
-        let mut best: Option<Clearance> = None;
-        let mut best_dist = threshold;
-        let target_aabb = target.aabb_in(&target.pose);
-        let support1 = ShapeSupport(&target.shape);
-        let radius = target.shape.bounding_radius();
-        for (oi, object) in self.objects().iter().enumerate() {
-            if !check(oi) || !object.world_aabb().loosened(best_dist).intersects(&target_aabb) {
-                continue;
-            }
-            let pose = object.pose;
-            let (area, tree) = match &object.body {
-                ObjectBody::Surface { area, tree } => (area, tree),
-                ObjectBody::Solid(shape) => {
-                    let target_in_object = pose.inv_mul(&target.pose);
-                    if !target.aabb_in(&target_in_object).loosened(best_dist).intersects(&shape.local_aabb()) {
-                        continue;
-                    }
-                    let pos12 = target.pose.inv_mul(&pose);
-                    if let Some((d, p1, p2)) = gjk_distance(&pos12, &support1, &ShapeSupport(shape), best_dist) {
-                        if d <= best_dist {
-                            best_dist = d;
-                            best = Some(Clearance { object: oi, triangle: u32::MAX, distance: d, point1: target.pose * p1, point2: target.pose * p2 });
-                        }
-                    }
-                    continue;
-                }
-            };
-            if tree.is_empty() {
-                continue;
-            }
-            let view = TargetView::new(target, &pose, area.side, &target_aabb);
-            // The surface-frame bounds, and the gap to the target's own box (tighter for a
-            // tilted, elongated link).
-            let bound = |c: Vector, h: Vector| lower_bound(&view.aabb, view.centre, radius, c, h).max(view.own_box_gap(c, h));
-            let (c, h) = tree.node_box(0);
-            let mut stack: Vec<(Real, u32)> = vec![(bound(c, h), 0)];
-            while let Some((lb, node)) = stack.pop() {
-                if lb > best_dist {
-                    continue;
-                }
-                if let Some(children) = tree.children(node) {
-                    let mut next = children.map(|child| {
-                        let (c, h) = tree.node_box(child);
-                        (bound(c, h), child)
-                    });
-                    // The nearer child on top of the stack.
-                    if next[0].0 < next[1].0 {
-                        next.swap(0, 1);
-                    }
-                    stack.extend(next.into_iter().filter(|(b, _)| *b <= best_dist));
-                    continue;
-                }
-                for (index, slab) in tree.leaf_cells(node) {
-                    if bound(slab.centre(), slab.half()) > best_dist {
-                        continue;
-                    }
-                    // The gap along the cell's normal (two support queries) before GJK.
-                    let [lo, hi] = view.extent_along(slab.normal);
-                    if (lo - slab.range[1]).max(slab.range[0] - hi) > best_dist {
-                        continue;
-                    }
-                    let cell = &area.cells[index as usize];
-                    let cell_support = CellSupport(cell.vertices());
-                    if let Some((d, p1, p2)) = gjk_distance(&view.object_in_target, &support1, &cell_support, best_dist) {
-                        if d <= best_dist {
-                            best_dist = d;
-                            best = Some(Clearance { object: oi, triangle: cell.triangle, distance: d, point1: target.pose * p1, point2: target.pose * p2 });
-                        }
-                    }
-                }
-            }
+        self.query(target, &check, Nearest { support: ShapeSupport(&target.shape), best: None, best_dist: threshold }).best
+    }
+}
+
+/// The collector of a clearance query: the nearest so far, whose distance is the reach.
+struct Nearest<'a> {
+    support: ShapeSupport<'a>,
+    best: Option<Clearance>,
+    best_dist: Real,
+}
+
+impl Nearest<'_> {
+    /// Keeps a distance (and nearest points, in the target's frame) if it is the nearest yet.
+    fn offer(&mut self, target: &Target, object: usize, triangle: u32, found: Option<(Real, Vector, Vector)>) {
+        if let Some((distance, p1, p2)) = found.filter(|f| f.0 <= self.best_dist) {
+            self.best_dist = distance;
+            self.best = Some(Clearance { object, triangle, distance, point1: target.pose * p1, point2: target.pose * p2 });
         }
-        best
+    }
+}
+
+impl Collector for Nearest<'_> {
+    fn reach(&self) -> Real {
+        self.best_dist
+    }
+
+    fn solid(&mut self, object: usize, target: &Target, pose: &Pose, shape: &TargetShape) -> ControlFlow<()> {
+        let found = gjk_distance(&target.pose.inv_mul(pose), &self.support, &ShapeSupport(shape), self.best_dist);
+        self.offer(target, object, u32::MAX, found);
+        ControlFlow::Continue(())
+    }
+
+    fn surface(&mut self, object: usize, area: &ThicknessArea, tree: &CellTree, view: &TargetView) -> ControlFlow<()> {
+        walk(tree, view, &mut NearestCell { nearest: self, object, area })
+    }
+}
+
+/// The visitor of one surface for [`Nearest`]: keys are the subtrees' distance bounds, negated.
+struct NearestCell<'n, 'a> {
+    nearest: &'n mut Nearest<'a>,
+    object: usize,
+    area: &'n ThicknessArea,
+}
+
+impl NearestCell<'_, '_> {
+    /// The surface-frame bounds, and the gap to the target's own box (tighter for a tilted,
+    /// elongated link).
+    fn bound(view: &TargetView, (c, h): (Vector, Vector)) -> Real {
+        lower_bound(&view.aabb, view.centre, view.radius, c, h).max(view.own_box_gap(c, h))
+    }
+}
+
+impl CellVisitor for NearestCell<'_, '_> {
+    fn root(&mut self, tree: &CellTree, view: &TargetView) -> Option<Real> {
+        Some(-Self::bound(view, tree.node_box(0)))
+    }
+
+    fn children(&mut self, tree: &CellTree, children: [u32; 2], view: &TargetView) -> [Option<Real>; 2] {
+        children.map(|child| Some(-Self::bound(view, tree.node_box(child))))
+    }
+
+    fn worth(&self, key: Real) -> bool {
+        -key <= self.nearest.best_dist
+    }
+
+    fn leaf(&mut self, tree: &CellTree, node: u32, view: &TargetView) -> ControlFlow<()> {
+        for (index, slab) in tree.leaf_cells(node) {
+            let best_dist = self.nearest.best_dist;
+            if Self::bound(view, (slab.centre(), slab.half())) > best_dist {
+                continue;
+            }
+            // The gap along the cell's normal (two support queries) before GJK.
+            let [lo, hi] = view.extent_along(slab.normal);
+            if (lo - slab.range[1]).max(slab.range[0] - hi) > best_dist {
+                continue;
+            }
+            let cell = &self.area.cells[index as usize];
+            let found = gjk_distance(&view.object_in_target, &self.nearest.support, &CellSupport(cell.vertices()), best_dist);
+            self.nearest.offer(view.target, self.object, cell.triangle, found);
+        }
+        ControlFlow::Continue(())
     }
 }
 

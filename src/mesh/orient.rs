@@ -23,53 +23,80 @@ pub(super) fn orient(mesh: &mut MeshTopology) {
         let id = closed.len() as u32;
         component[seed] = id;
         queue.push_back(seed);
-        let mut members = Vec::new();
-        let mut is_closed = true;
-        while let Some(f) = queue.pop_front() {
-            members.push(f);
-            for link in mesh.links[f] {
-                match link {
-                    EdgeLink::Shared { face, consistent } => {
-                        let g = face as usize;
-                        if component[g] == u32::MAX {
-                            component[g] = id;
-                            flip[g] = flip[f] ^ !consistent;
-                            queue.push_back(g);
-                        }
-                    }
-                    _ => is_closed = false,
-                }
-            }
-        }
-        // Signed volume (closed) or flipped-vs-kept area (open), after the relative flips.
-        let mut volume = 0.0;
-        let mut kept_area = 0.0;
-        let mut flipped_area = 0.0;
-        for &f in &members {
-            let [a, b, c] = mesh.triangles[f].map(|i| mesh.vertices[i as usize]);
-            let s: Real = if flip[f] { -1.0 } else { 1.0 };
-            volume += s * a.dot(b.cross(c));
-            let area = (b - a).cross(c - a).length();
-            if flip[f] {
-                flipped_area += area;
-            } else {
-                kept_area += area;
-            }
-        }
-        let invert = if is_closed { volume < 0.0 } else { flipped_area > kept_area };
-        if invert {
+        let (members, is_closed) = flood(mesh, id, &mut component, &mut flip, &mut queue);
+        if should_invert(mesh, &members, &flip, is_closed) {
             for &f in &members {
                 flip[f] = !flip[f];
             }
         }
         closed.push(is_closed);
     }
+    let (flipped, inconsistent) = apply_flips(mesh, &flip);
+    mesh.report.flipped_faces = flipped;
+    mesh.report.inconsistent_edges = inconsistent;
+    mesh.report.closed_components = closed.iter().filter(|&&c| c).count();
+    mesh.report.open_components = closed.len() - mesh.report.closed_components;
+    mesh.component = component;
+    mesh.component_closed = closed;
+}
+
+/// The faces reached from those in `queue` over shared edges, each given component `id` and its
+/// flip relative to the face it was reached from; and whether the component has no open edge.
+fn flood(mesh: &MeshTopology, id: u32, component: &mut [u32], flip: &mut [bool], queue: &mut VecDeque<usize>) -> (Vec<usize>, bool) {
+    let mut members = Vec::new();
+    let mut is_closed = true;
+    while let Some(f) = queue.pop_front() {
+        members.push(f);
+        for link in mesh.links[f] {
+            match link {
+                EdgeLink::Shared { face, consistent } => {
+                    let g = face as usize;
+                    if component[g] == u32::MAX {
+                        component[g] = id;
+                        flip[g] = flip[f] ^ !consistent;
+                        queue.push_back(g);
+                    }
+                }
+                _ => is_closed = false,
+            }
+        }
+    }
+    (members, is_closed)
+}
+
+/// Whether a component, after its relative flips, faces the wrong way: inward (negative signed
+/// volume) when closed, else with more of its area flipped than kept.
+fn should_invert(mesh: &MeshTopology, members: &[usize], flip: &[bool], is_closed: bool) -> bool {
+    let mut volume = 0.0;
+    let mut kept_area = 0.0;
+    let mut flipped_area = 0.0;
+    for &f in members {
+        let [a, b, c] = mesh.triangles[f].map(|i| mesh.vertices[i as usize]);
+        let s: Real = if flip[f] { -1.0 } else { 1.0 };
+        volume += s * a.dot(b.cross(c));
+        let area = (b - a).cross(c - a).length();
+        if flip[f] {
+            flipped_area += area;
+        } else {
+            kept_area += area;
+        }
+    }
+    if is_closed {
+        volume < 0.0
+    } else {
+        flipped_area > kept_area
+    }
+}
+
+/// Flips the faces marked in `flip` and updates every shared edge's consistency; returns the
+/// faces flipped and the shared edges whose faces still disagree (each counted once).
+fn apply_flips(mesh: &mut MeshTopology, flip: &[bool]) -> (usize, usize) {
+    let n = mesh.triangles.len();
     let mut flipped = 0;
     for f in 0..n {
         if flip[f] {
             flipped += 1;
-            let t = &mut mesh.triangles[f];
-            t.swap(1, 2);
+            mesh.triangles[f].swap(1, 2);
             // Edge i of [a, c, b] is edge 2 - i of [a, b, c], reversed.
             mesh.links[f].swap(0, 2);
         }
@@ -86,10 +113,5 @@ pub(super) fn orient(mesh: &mut MeshTopology) {
             }
         }
     }
-    mesh.report.flipped_faces = flipped;
-    mesh.report.inconsistent_edges = inconsistent;
-    mesh.report.closed_components = closed.iter().filter(|&&c| c).count();
-    mesh.report.open_components = closed.len() - mesh.report.closed_components;
-    mesh.component = component;
-    mesh.component_closed = closed;
+    (flipped, inconsistent)
 }

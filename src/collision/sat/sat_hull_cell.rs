@@ -2,8 +2,8 @@
 
 use super::gauss_map::is_minkowski_face_arcs;
 use super::{LeastOverlap, SatOverlap};
+use crate::collision::convex_hull::ConvexHull;
 use crate::collision::polytope::CellPolytope;
-use crate::collision::target::ConvexHull;
 use crate::math::Vector;
 
 /// Exact SAT of `hull` against `cell` (both in the hull's frame): the least overlap, or when an
