@@ -188,7 +188,7 @@ impl CellTree {
     }
 
     /// The box around every cell (invalid when there are none).
-    pub fn root_aabb(&self) -> Aabb {
+    pub(crate) fn root_aabb(&self) -> Aabb {
         self.nodes.first().map_or(Aabb::new_invalid(), |n| Aabb::new(n.lo, n.hi))
     }
 

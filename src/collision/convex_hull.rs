@@ -246,7 +246,7 @@ impl ConvexHull {
     /// faces, then hulled again. Every face moves out by exactly `padding`; edges and corners are
     /// bevelled, short of the rounded Minkowski sum by at most `padding * (1 - cos(a/2))` for a
     /// dihedral angle `a` between face normals.
-    pub fn padded(&self, padding: Real) -> Option<ConvexHull> {
+    pub(crate) fn padded(&self, padding: Real) -> Option<ConvexHull> {
         if padding == 0.0 {
             return Some(self.clone());
         }

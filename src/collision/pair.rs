@@ -8,7 +8,7 @@ use crate::math::{Real, Vector};
 
 /// A contact between two parts, in the world frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PairContact {
+pub(crate) struct PairContact {
     /// Penetration depth: the least translation that separates them (metres, `> 0`).
     pub depth: Real,
     /// Unit direction in which the first part moves by `depth` to separate.
@@ -34,7 +34,7 @@ impl TargetShape {
 }
 
 /// Whether two posed parts overlap, and how deep; touching counts as apart.
-pub fn collide_pair(a: &Target, b: &Target) -> Option<PairContact> {
+pub(crate) fn collide_pair(a: &Target, b: &Target) -> Option<PairContact> {
     match verdict(a, b)? {
         Verdict::Apart(_) => None,
         Verdict::Overlap | Verdict::Unknown => depth(a, b),
@@ -44,7 +44,7 @@ pub fn collide_pair(a: &Target, b: &Target) -> Option<PairContact> {
 /// Whether two posed parts may meet: `false` only with a proof (their bounding balls apart, or a
 /// separating axis). A motion's stretch is cleared on this alone: the depth (EPA) of a pair that
 /// overlaps cost 24 µs a test on the motion benchmark, the whole answer only ~1 µs.
-pub fn pair_may_meet(a: &Target, b: &Target) -> bool {
+pub(crate) fn pair_may_meet(a: &Target, b: &Target) -> bool {
     !matches!(verdict(a, b), None | Some(Verdict::Apart(_)))
 }
 

@@ -120,7 +120,7 @@ impl TargetShape {
     /// Calls `f` with the same shape for parry's GJK/EPA queries and its pose in this shape's
     /// frame (parry's cylinders run along `y`). Hulls are lent, not cloned: a clone of a
     /// 100-vertex polyhedron cost more than the query.
-    pub fn with_parry<R>(&self, f: impl FnOnce(&dyn parry3d_f64::shape::Shape, &Pose) -> R) -> R {
+    pub(crate) fn with_parry<R>(&self, f: impl FnOnce(&dyn parry3d_f64::shape::Shape, &Pose) -> R) -> R {
         use parry3d_f64::shape::{Ball, Capsule, Cylinder};
         match self {
             TargetShape::Polytope(h) => f(h.as_parry(), &Pose::IDENTITY),
@@ -133,7 +133,7 @@ impl TargetShape {
     }
 
     /// Whether the shape's sizes are positive and finite.
-    pub fn is_valid(&self) -> bool {
+    pub(crate) fn is_valid(&self) -> bool {
         match self {
             TargetShape::Polytope(_) => true,
             TargetShape::Sphere { radius } => *radius > 0.0 && radius.is_finite(),
