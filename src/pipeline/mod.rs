@@ -20,7 +20,7 @@ mod validity;
 
 pub use self::report_adapter::{report_message, CheckedState};
 pub use self::skip::{Skip, SkipCause};
-pub use self::state_line::{parse_state_line, LinkTransform, StateLine};
+pub use self::state_line::{parse_state_line, LinkTransform, StateLine, StateLineError};
 pub use self::state_pipeline::{Pipeline, RobotState};
 
 // The node's and replay's own steps: `/tf` of a state, and the request jobs the node's workers run

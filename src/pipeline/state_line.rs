@@ -59,8 +59,17 @@ struct TransformsLine {
 const EXPECTED: &str =
     "expected {\"name\": [...], \"position\": [...]} or {\"transforms\": [{\"link\", \"translation\", \"rotation\"}]}, with an optional \"stamp\"";
 
-/// Parses a line; the error is one line saying what is wrong and what is expected.
-pub fn parse_state_line(line: &str) -> Result<StateLine, String> {
+/// Why a `check --states` line is not a state: one line saying what is wrong and what is expected.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct StateLineError(String);
+
+/// Parses a line of a `check --states` file.
+pub fn parse_state_line(line: &str) -> Result<StateLine, StateLineError> {
+    parse(line).map_err(StateLineError)
+}
+
+fn parse(line: &str) -> Result<StateLine, String> {
     let line = line.strip_prefix('\u{feff}').unwrap_or(line);
     let value: serde_json::Value = serde_json::from_str(line).map_err(|e| format!("not JSON ({e}); {EXPECTED}"))?;
     let Some(object) = value.as_object() else {
@@ -136,13 +145,13 @@ mod tests {
     fn lines_and_their_errors() {
         let j = parse_state_line("\u{feff}{\"name\": [\"a\"], \"position\": [1.5], \"stamp\": 7}").unwrap();
         assert_eq!(j, StateLine::Joints { name: vec!["a".into()], position: vec![1.5], stamp: 7 });
-        let e = parse_state_line("[1, 2]").unwrap_err();
+        let e = parse_state_line("[1, 2]").unwrap_err().to_string();
         assert!(e.starts_with("a JSON array instead of an object"), "{e}");
-        let e = parse_state_line("{\"joints\": {}}").unwrap_err();
+        let e = parse_state_line("{\"joints\": {}}").unwrap_err().to_string();
         assert!(e.starts_with("an object with keys [joints]"), "{e}");
-        let e = parse_state_line("{\"name\": [\"a\"], \"position\": [\"x\"]}").unwrap_err();
+        let e = parse_state_line("{\"name\": [\"a\"], \"position\": [\"x\"]}").unwrap_err().to_string();
         assert!(e.starts_with("a joint state: invalid type: string \"x\", expected f64"), "{e}");
-        let e = parse_state_line("{\"transforms\": [{\"link\": \"a\", \"translation\": [0, 0], \"rotation\": [0, 0, 0, 1]}]}").unwrap_err();
+        let e = parse_state_line("{\"transforms\": [{\"link\": \"a\", \"translation\": [0, 0], \"rotation\": [0, 0, 0, 1]}]}").unwrap_err().to_string();
         assert!(e.starts_with("a transforms state:") && e.contains("length 2"), "{e}");
         assert!(!e.contains('\n'));
     }
