@@ -193,3 +193,31 @@ fn missing_states_file_is_reported_once() {
     let last = stderr.trim_end().lines().last().unwrap_or("");
     assert_eq!(last.matches("No such file").count(), 1, "{last}");
 }
+
+/// A robot whose joints are all fixed has one pose, which any joint state stands for: `--joints`
+/// naming its fixed joint and every line of a states file (even an empty state) are checked as
+/// that pose, with the same answer.
+#[test]
+fn a_robot_without_actuated_joints_checks_its_one_pose() {
+    let robot = tmp("fixed_only.urdf");
+    std::fs::write(
+        &robot,
+        r#"<robot name="fixed_only"><link name="base"/><link name="arm"><collision><origin xyz="0.2 0 0"/><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link><joint name="f" type="fixed"><parent link="base"/><child link="arm"/></joint></robot>"#,
+    )
+    .unwrap();
+    let env = tmp("fixed_only_env.urdf");
+    std::fs::write(
+        &env,
+        r#"<robot name="cell"><link name="world"/><link name="block"><collision><origin xyz="0.25 0 0"/><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link><joint name="j" type="fixed"><parent link="world"/><child link="block"/></joint></robot>"#,
+    )
+    .unwrap();
+    let (r, e) = (robot.to_str().unwrap(), env.to_str().unwrap());
+    let joints = ok(bin().args(["check", "--robot", r, "--environment", e, "--joints", "f=0", "--json"]).output().unwrap());
+    let v: serde_json::Value = serde_json::from_str(joints.trim()).unwrap();
+    assert_eq!((&v["in_collision"], &v["contacts"][0]["object_name"]), (&serde_json::json!(true), &serde_json::json!("block")), "{v}");
+    let states = tmp("fixed_only.jsonl");
+    std::fs::write(&states, "{\"name\": [\"f\"], \"position\": [0]}\n{\"name\": [], \"position\": []}\n").unwrap();
+    let lines = ok(bin().args(["check", "--robot", r, "--environment", e, "--states", states.to_str().unwrap(), "--json"]).output().unwrap());
+    let lines: Vec<&str> = lines.lines().collect();
+    assert_eq!(lines, [joints.trim(), joints.trim()], "every state is the one pose");
+}
