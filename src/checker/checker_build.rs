@@ -11,7 +11,7 @@ use crate::collision::{ConvexHull, Scene, TargetShape};
 use crate::math::pose_from_isometry;
 use crate::mesh::{MeshTopology, TopologySettings};
 use crate::model::MeshData;
-use crate::model::{GeometrySpec, LinkModel, ModelError, PackageResolver, Params, RobotModel, Srdf};
+use crate::model::{GeometrySpec, ModelError, PackageResolver, Params, RobotModel, Srdf};
 use crate::thickness::{Side, ThicknessArea, ThicknessSettings};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use std::path::Path;
@@ -185,7 +185,7 @@ fn environment_scene(params: &Params, env: &RobotModel, cache: &mut MeshCache, s
                         link: link.name.clone(),
                         error,
                     })?;
-                    add_environment_mesh(params, &mut scene, link, pose, &data, summary).map_err(|message| CheckerError::Geometry {
+                    add_environment_mesh(params, &mut scene, &link.name, pose, &data, summary).map_err(|message| CheckerError::Geometry {
                         file: summary.environment_source.clone(),
                         link: link.name.clone(),
                         what: format!("mesh {}", path.display()),
@@ -210,27 +210,27 @@ fn environment_scene(params: &Params, env: &RobotModel, cache: &mut MeshCache, s
 
 /// One environment mesh into `scene`: a solid (its convex hull) when closed and named in
 /// `solid_hull`, else a thin surface. The error is what is wrong with the mesh.
-fn add_environment_mesh(
+pub(super) fn add_environment_mesh(
     params: &Params,
     scene: &mut Scene,
-    link: &LinkModel,
+    name: &str,
     pose: crate::math::Pose,
     data: &MeshData,
     summary: &mut BuildSummary,
 ) -> Result<(), String> {
     let mesh = MeshTopology::build(&data.vertices, &data.triangles, &TopologySettings::default()).map_err(|e| e.to_string())?;
     let closed = mesh.report.boundary_edges == 0 && mesh.report.non_manifold_edges == 0;
-    if closed && params.is_solid_hull(&link.name) {
+    if closed && params.is_solid_hull(name) {
         let hull = ConvexHull::from_points(&data.vertices).ok_or_else(|| "its convex hull is flat".to_owned())?;
-        let _ = scene.add_solid(link.name.clone(), pose, TargetShape::Polytope(Arc::new(hull)));
+        let _ = scene.add_solid(name.to_owned(), pose, TargetShape::Polytope(Arc::new(hull)));
         summary.solids += 1;
     } else {
-        let (thickness, side) = params.surface_settings(&link.name);
+        let (thickness, side) = params.surface_settings(name);
         // A closed mesh has an inside: its cells go inward.
         let side = if closed { Side::Back } else { side };
         let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() }).map_err(|e| e.to_string())?;
         summary.cells += area.cells.len();
-        let _ = scene.add_surface(link.name.clone(), pose, area);
+        let _ = scene.add_surface(name.to_owned(), pose, area);
         summary.thin_surfaces += 1;
     }
     Ok(())

@@ -1,0 +1,166 @@
+//! The shapes of planning-scene objects as the checks see them: each object exactly as an
+//! environment URDF link of its id would be (a mesh with a boundary is a thin surface with cells,
+//! with `thin_surfaces`' thickness and side for its id; a closed mesh named in `solid_hull` is
+//! its hull; primitives are solids).
+
+use super::checker::BuildSummary;
+use super::checker_build::add_environment_mesh;
+use super::geometry_shapes::primitive_shape;
+use crate::collision::{ConvexHull, Scene, TargetShape};
+use crate::math::{Pose, Vector};
+use crate::model::{GeometrySpec, MeshData, Params};
+use std::sync::Arc;
+
+/// A shape of a planning-scene object, as `shape_msgs` define it (metres, in the shape's frame,
+/// centred on its bounding box).
+#[derive(Clone, Debug)]
+pub(crate) enum WorldShape {
+    /// Full side lengths.
+    Box([f64; 3]),
+    Sphere(f64),
+    /// Along z.
+    Cylinder {
+        height: f64,
+        radius: f64,
+    },
+    /// Along z, its tip at `+height / 2`.
+    Cone {
+        height: f64,
+        radius: f64,
+    },
+    /// The polygon (x, y, counter-clockwise) extruded by `height / 2` both ways along z.
+    Prism {
+        height: f64,
+        polygon: Vec<[f64; 2]>,
+    },
+    /// Triangles whose front is the side their vertices wind counter-clockwise around.
+    Mesh(MeshData),
+}
+
+/// Corners of the polygon around a cone's base: circumscribed, so that the hull holds the cone
+/// (it reaches at most `radius * (1 / cos(pi / 64) - 1)`, 0.12 % of the radius, beyond it).
+const CONE_SIDES: usize = 64;
+
+/// Adds one object's shapes to `scene` under the object's id, at `object_pose` and each shape's
+/// pose relative to it. The error is what is wrong with a shape, naming it by its index.
+pub(crate) fn add_world_object(
+    params: &Params,
+    scene: &mut Scene,
+    id: &str,
+    object_pose: &Pose,
+    shapes: &[(WorldShape, Pose)],
+    summary: &mut BuildSummary,
+) -> Result<(), String> {
+    for (k, (shape, pose)) in shapes.iter().enumerate() {
+        let pose = *object_pose * *pose;
+        if let WorldShape::Mesh(data) = shape {
+            add_environment_mesh(params, scene, id, pose, data, summary).map_err(|e| format!("shape {k} (a mesh): {e}"))?;
+            continue;
+        }
+        let solid = solid(shape).ok_or_else(|| format!("shape {k} ({shape_kind}): not a usable convex shape", shape_kind = kind(shape)))?;
+        let _ = scene.add_solid(id.to_owned(), pose, solid);
+        summary.solids += 1;
+    }
+    Ok(())
+}
+
+fn kind(shape: &WorldShape) -> &'static str {
+    match shape {
+        WorldShape::Box(_) => "a box",
+        WorldShape::Sphere(_) => "a sphere",
+        WorldShape::Cylinder { .. } => "a cylinder",
+        WorldShape::Cone { .. } => "a cone",
+        WorldShape::Prism { .. } => "a prism",
+        WorldShape::Mesh(_) => "a mesh",
+    }
+}
+
+/// A primitive as a solid; `None` when its sizes are not positive and finite (a prism's polygon
+/// is taken as its convex hull).
+fn solid(shape: &WorldShape) -> Option<TargetShape> {
+    let hull = |points: Vec<Vector>| ConvexHull::from_points(&points).map(|h| TargetShape::Polytope(Arc::new(h)));
+    match shape {
+        WorldShape::Box(size) => primitive_shape(&GeometrySpec::Box(*size), 0.0),
+        WorldShape::Sphere(r) => primitive_shape(&GeometrySpec::Sphere(*r), 0.0),
+        WorldShape::Cylinder { height, radius } => primitive_shape(&GeometrySpec::Cylinder { radius: *radius, length: *height }, 0.0),
+        WorldShape::Cone { height, radius } => {
+            if !(*height > 0.0 && *radius > 0.0 && height.is_finite() && radius.is_finite()) {
+                return None;
+            }
+            let out = radius / (std::f64::consts::PI / CONE_SIDES as f64).cos();
+            let mut points: Vec<Vector> = (0..CONE_SIDES)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / CONE_SIDES as f64;
+                    Vector::new(out * a.cos(), out * a.sin(), -height / 2.0)
+                })
+                .collect();
+            points.push(Vector::new(0.0, 0.0, height / 2.0));
+            hull(points)
+        }
+        WorldShape::Prism { height, polygon } => {
+            if !(*height > 0.0 && height.is_finite()) || polygon.iter().flatten().any(|x| !x.is_finite()) {
+                return None;
+            }
+            hull(polygon.iter().flat_map(|[x, y]| [Vector::new(*x, *y, -height / 2.0), Vector::new(*x, *y, height / 2.0)]).collect())
+        }
+        WorldShape::Mesh(_) => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collision::{CollideSettings, Target};
+    use crate::mesh::generate;
+
+    /// An object made of a box and an open mesh gives, for random targets, the same contacts as
+    /// the environment link of the same name and geometry (its box a URDF primitive, its mesh
+    /// read as a mesh file would be): the same objects, depths, normals and points.
+    #[test]
+    fn an_object_is_checked_as_the_environment_link_of_its_id() {
+        let params = Params::default();
+        let (v, t) = generate::flat_grid(8, 8, 1.0, 1.0);
+        let mesh = MeshData { vertices: v.clone(), triangles: t.clone() };
+        let object_pose = Pose::from_translation(Vector::new(0.3, -0.2, 0.1));
+        let box_pose = Pose::from_translation(Vector::new(0.0, 0.0, 0.5));
+        let shapes = [(WorldShape::Box([0.2, 0.3, 0.4]), box_pose), (WorldShape::Mesh(mesh.clone()), Pose::IDENTITY)];
+        let mut world = Scene::new();
+        let mut summary = BuildSummary::default();
+        add_world_object(&params, &mut world, "shelf", &object_pose, &shapes, &mut summary).unwrap();
+        assert_eq!((summary.solids, summary.thin_surfaces, summary.cells), (1, 1, t.len()));
+        // The twin: what an environment link "shelf" with a box and that mesh builds.
+        let mut twin = Scene::new();
+        let _ = twin.add_solid("shelf", object_pose * box_pose, primitive_shape(&GeometrySpec::Box([0.2, 0.3, 0.4]), 0.0).unwrap());
+        add_environment_mesh(&params, &mut twin, "shelf", object_pose, &mesh, &mut BuildSummary::default()).unwrap();
+        let mut rng = oorandom::Rand64::new(32);
+        let mut r = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
+        let mut colliding = 0;
+        for _ in 0..400 {
+            let at = Vector::new(r(0.2, 1.4), r(-0.3, 0.9), r(-0.1, 0.7));
+            let target = Target::new(TargetShape::cuboid(Vector::new(r(0.01, 0.1), r(0.01, 0.1), r(0.01, 0.1))).unwrap(), Pose::from_translation(at));
+            let (a, b) = (world.collide(&target, &CollideSettings::default()), twin.collide(&target, &CollideSettings::default()));
+            assert_eq!((&a.objects, &a.contacts), (&b.objects, &b.contacts), "at {at:?}");
+            colliding += a.in_collision() as usize;
+        }
+        assert!(colliding > 40 && colliding < 360, "{colliding} of 400 collide: the cases must mix");
+    }
+
+    /// A cone's hull holds the cone and lies within 0.2 % of its radius of it; a prism's hull is
+    /// its polygon extruded; bad sizes are refused, naming the shape.
+    #[test]
+    fn cones_and_prisms_become_hulls() {
+        let cone = solid(&WorldShape::Cone { height: 0.4, radius: 0.1 }).unwrap();
+        let TargetShape::Polytope(h) = &cone else { panic!("a cone is a hull") };
+        for p in h.points() {
+            assert!((p.z - 0.2).abs() < 1e-12 || (p.z + 0.2).abs() < 1e-12, "{p:?}");
+            let r = p.truncate().length();
+            assert!(r < 1e-12 || (r > 0.1 && r < 0.1002), "{p:?}");
+        }
+        let prism = solid(&WorldShape::Prism { height: 0.2, polygon: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] }).unwrap();
+        assert_eq!(prism.local_aabb().maxs, Vector::new(1.0, 1.0, 0.1));
+        let mut scene = Scene::new();
+        let e =
+            add_world_object(&Params::default(), &mut scene, "x", &Pose::IDENTITY, &[(WorldShape::Sphere(-1.0), Pose::IDENTITY)], &mut BuildSummary::default());
+        assert_eq!(e, Err("shape 0 (a sphere): not a usable convex shape".to_owned()));
+    }
+}
