@@ -52,6 +52,8 @@ pub struct Checker {
     /// `moving[j]`: joint `j` takes a position from joint states and moves a checked link (itself,
     /// or through a mimic). A state is complete when all of these are known.
     pub(super) moving: Vec<bool>,
+    /// The scene's first objects are the environment's; planning-scene objects follow.
+    pub(super) environment_objects: usize,
 }
 
 impl Checker {

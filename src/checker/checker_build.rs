@@ -61,6 +61,7 @@ impl Checker {
         checker.summary.thin_surfaces = scene.objects().iter().filter(|o| o.area().is_some()).count();
         checker.summary.cells = scene.cell_count();
         checker.allowed = allowed_matrix(&checker.params, &checker.targets, &scene);
+        checker.environment_objects = scene.objects().len();
         checker.scene = Arc::new(scene);
         checker.with_semantic_file()
     }
@@ -103,6 +104,7 @@ impl Checker {
         summary.meshes_read = cache.files_read();
         summary.build_seconds = started.elapsed().as_secs_f64();
         let base = base_isometry(&params.robot_base_pose);
+        let scene_objects = scene.objects().len();
         Ok(Checker {
             params,
             robot,
@@ -114,6 +116,7 @@ impl Checker {
             motion: OnceLock::new(),
             self_pairs: SelfPairs::default(),
             moving,
+            environment_objects: scene_objects,
         })
     }
 
@@ -156,6 +159,7 @@ impl Checker {
             motion: self.motion.clone(),
             self_pairs: SelfPairs::default(),
             moving: self.moving.clone(),
+            environment_objects: self.environment_objects,
         };
         checker.with_semantic(text, source)
     }
@@ -279,7 +283,7 @@ fn link_part(spec: &GeometrySpec, padding: f64, cache: &mut MeshCache, file: &st
 }
 
 /// `allowed[target][object]`: the pairs `allowed_collisions` never reports.
-fn allowed_matrix(params: &Params, targets: &[LinkTargets], scene: &Scene) -> Vec<Vec<bool>> {
+pub(super) fn allowed_matrix(params: &Params, targets: &[LinkTargets], scene: &Scene) -> Vec<Vec<bool>> {
     targets.iter().map(|t| scene.objects().iter().map(|o| params.is_allowed(&t.name, &o.name)).collect()).collect()
 }
 

@@ -24,6 +24,14 @@ pub enum CheckerError {
         /// Why.
         error: MeshFileError,
     },
+    /// A planning-scene object that cannot be checked: the scene in force stays.
+    #[error("collision object '{id}': {message}")]
+    WorldObject {
+        /// The object's id.
+        id: String,
+        /// Why.
+        message: String,
+    },
     /// Building panicked (a defect, in this crate or a dependency): contained, so the robot in
     /// use stays.
     #[error("building the checker failed: {0}")]

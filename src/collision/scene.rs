@@ -8,6 +8,7 @@ use super::target_view::{transformed_box, TargetView};
 use crate::math::{Aabb, Pose};
 use crate::thickness::ThicknessArea;
 use parry3d_f64::bounding_volume::BoundingVolume;
+use std::sync::Arc;
 
 /// What an environment object is made of.
 // A scene holds a handful of objects; boxing the surface would add an indirection to every query.
@@ -56,9 +57,11 @@ impl SceneObject {
 }
 
 /// Environment objects and the queries of convex targets against them.
-#[derive(Default)]
+// Objects are shared, so that a scene of the same environment with other planning-scene objects
+// is made without copying any cells.
+#[derive(Clone, Default)]
 pub struct Scene {
-    objects: Vec<SceneObject>,
+    objects: Vec<Arc<SceneObject>>,
 }
 
 impl Scene {
@@ -73,20 +76,25 @@ impl Scene {
     pub fn add_surface(&mut self, name: impl Into<String>, pose: Pose, mut area: ThicknessArea) -> usize {
         let tree = CellTree::build(&mut area.cells);
         let world_aabb = if tree.is_empty() { Aabb::new_invalid() } else { transformed_box(&tree.root_aabb(), &pose) };
-        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Surface { area, tree }, world_aabb });
+        self.objects.push(Arc::new(SceneObject { name: name.into(), pose, body: ObjectBody::Surface { area, tree }, world_aabb }));
         self.objects.len() - 1
     }
 
     /// Adds a convex solid placed at `pose` in the world. Returns the object's index.
     pub fn add_solid(&mut self, name: impl Into<String>, pose: Pose, shape: TargetShape) -> usize {
         let world_aabb = transformed_box(&shape.local_aabb(), &pose);
-        self.objects.push(SceneObject { name: name.into(), pose, body: ObjectBody::Solid(shape), world_aabb });
+        self.objects.push(Arc::new(SceneObject { name: name.into(), pose, body: ObjectBody::Solid(shape), world_aabb }));
         self.objects.len() - 1
     }
 
     /// The objects, in the order they were added.
-    pub fn objects(&self) -> &[SceneObject] {
+    pub fn objects(&self) -> &[Arc<SceneObject>] {
         &self.objects
+    }
+
+    /// The first `count` objects of this scene, then those of `more` (shared, not copied).
+    pub(crate) fn prefix_with(&self, count: usize, more: &Scene) -> Scene {
+        Scene { objects: self.objects.iter().take(count).chain(&more.objects).cloned().collect() }
     }
 
     /// Checks one target against every object.

@@ -1,0 +1,111 @@
+//! A checker with a planning scene's objects beside its environment.
+
+use super::checker::{BuildSummary, Checker};
+use super::checker_build::allowed_matrix;
+use super::checker_error::CheckerError;
+use super::world_shapes::{add_world_object, WorldShape};
+use crate::collision::Scene;
+use crate::math::Pose;
+use std::sync::Arc;
+
+impl Checker {
+    /// This checker with the planning scene's `objects` (id, pose in the world, shapes with their
+    /// poses relative to it) after the environment's (those of an earlier call
+    /// replaced), each checked exactly as an environment link of its id would be, with the same
+    /// `allowed_collisions`. An id that names an environment object or a robot link is refused,
+    /// as is a shape that cannot be used. The build summary stays the environment's.
+    pub(crate) fn with_world<'a>(&self, objects: impl IntoIterator<Item = (&'a str, &'a Pose, &'a [(WorldShape, Pose)])>) -> Result<Checker, CheckerError> {
+        let environment = &self.scene.objects()[..self.environment_objects];
+        let mut added = Scene::new();
+        for (id, pose, shapes) in objects {
+            let refuse = |message: &str| CheckerError::WorldObject { id: id.to_owned(), message: message.to_owned() };
+            if environment.iter().any(|o| o.name == id) {
+                return Err(refuse("the id names an object of the environment"));
+            }
+            if self.robot.link(id).is_some() {
+                return Err(refuse("the id names a link of the robot"));
+            }
+            add_world_object(&self.params, &mut added, id, pose, shapes, &mut BuildSummary::default()).map_err(|m| refuse(&m))?;
+        }
+        let scene = self.scene.prefix_with(self.environment_objects, &added);
+        Ok(Checker {
+            params: self.params.clone(),
+            robot: self.robot.clone(),
+            targets: self.targets.clone(),
+            allowed: allowed_matrix(&self.params, &self.targets, &scene),
+            scene: Arc::new(scene),
+            summary: self.summary.clone(),
+            base: self.base,
+            motion: self.motion.clone(),
+            self_pairs: self.self_pairs.clone(),
+            moving: self.moving.clone(),
+            environment_objects: self.environment_objects,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vector;
+    use crate::mesh::generate;
+    use crate::model::{read_mesh, MeshData, PackageResolver, Params, RobotModel};
+    use std::fmt::Write as _;
+
+    /// The bundled workcell with a planning-scene object (a box and an open sheet) gives, for
+    /// random joint states, the same reports as the workcell whose environment URDF has a link of
+    /// the object's id with the same box and the sheet as an OBJ file; an id that names an
+    /// environment object or a robot link is refused.
+    #[test]
+    fn an_object_is_checked_as_its_urdf_twin() {
+        let params = Params::default();
+        let base = Checker::from_params(params.clone()).unwrap();
+        let (v, t) = generate::flat_grid(6, 6, 0.5, 0.5);
+        let dir = std::env::temp_dir().join(format!("tc_world_objects_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut obj = String::new();
+        for p in &v {
+            let _ = writeln!(obj, "v {} {} {}", p.x, p.y, p.z);
+        }
+        for f in &t {
+            let _ = writeln!(obj, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1);
+        }
+        std::fs::write(dir.join("fixture.obj"), obj).unwrap();
+        // The mesh as the file reader gives it (single-precision coordinates), so that both sides
+        // hold the same triangles: on a flat sheet, rounding alone picks another of equally deep cells.
+        let sheet: MeshData = read_mesh(&dir.join("fixture.obj"), Vector::ONE).unwrap();
+        assert_eq!(sheet.triangles.len(), t.len());
+        let sheet_pose = Pose::from_translation(Vector::new(-0.1, 0.2, 0.1));
+        let shapes = [(WorldShape::Box([0.3, 0.2, 0.1]), Pose::from_translation(Vector::new(0.0, 0.0, 0.2))), (WorldShape::Mesh(sheet), sheet_pose)];
+        let object_pose = Pose::from_translation(Vector::new(0.35, 0.0, 0.3));
+        let with = base.with_world([("fixture", &object_pose, &shapes[..])]).unwrap();
+        let env_path = params.environment_path();
+        let env_text = std::fs::read_to_string(&env_path).unwrap();
+        let link = format!(
+            "<link name=\"fixture\"><collision><origin xyz=\"0 0 0.2\"/><geometry><box size=\"0.3 0.2 0.1\"/></geometry></collision><collision><origin xyz=\"-0.1 0.2 0.1\"/><geometry><mesh filename=\"{}\"/></geometry></collision></link><joint name=\"fixture_joint\" type=\"fixed\"><parent link=\"world\"/><child link=\"fixture\"/><origin xyz=\"0.35 0 0.3\"/></joint></robot>",
+            dir.join("fixture.obj").display()
+        );
+        let twin_text = env_text.replacen("</robot>", &link, 1);
+        let resolver = PackageResolver::default();
+        let env = RobotModel::from_str(&twin_text, "twin.urdf", env_path.parent().unwrap(), &resolver, false).unwrap();
+        let robot = RobotModel::from_file(&params.robot_path(), &resolver, false).unwrap();
+        let twin = Checker::from_models(params, robot, env, "robot".into(), "twin".into(), None).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+
+        let names: Vec<String> = with.robot().joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
+        let mut rng = oorandom::Rand64::new(7);
+        let (mut colliding, mut with_fixture) = (0, 0);
+        for _ in 0..300 {
+            let q: Vec<f64> = names.iter().map(|_| -2.0 + 4.0 * rng.rand_float()).collect();
+            let (mut a, mut b) = (with.check_joints(&names, &q).unwrap(), twin.check_joints(&names, &q).unwrap());
+            (a.check_seconds, b.check_seconds) = (0.0, 0.0);
+            assert_eq!(a, b, "at {q:?}");
+            colliding += a.in_collision as usize;
+            with_fixture += a.contacts.iter().any(|c| c.object_name == "fixture") as usize;
+        }
+        assert!(with_fixture > 10 && colliding < 300, "{with_fixture} states touch the fixture, {colliding} of 300 collide");
+        let refusal = |id: &str| base.with_world([(id, &object_pose, &shapes[..])]).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(refusal("guard_sheet").contains("names an object of the environment"), "{}", refusal("guard_sheet"));
+        assert!(refusal("base_link").contains("names a link of the robot"), "{}", refusal("base_link"));
+    }
+}
