@@ -17,7 +17,8 @@ use crate::msgs::{CollisionReport, JointState, JointTrajectory};
 use crate::pipeline::{Pipeline, TrajectoryJob};
 
 pub use crate::model::mesh_file::parse_mesh;
-pub use crate::msgs::moveit::{AttachedCollisionObject, GetStateValidityRequest, GetStateValidityResponse, JointConstraint, RobotStateMsg};
+pub use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse, JointConstraint};
+pub use crate::msgs::planning_scene::{AttachedCollisionObject, RobotStateMsg};
 pub use crate::replay::bag_reader::{open_bag, BagMessage, BagReader};
 
 /// Builds the self-collision pairs of `checker`'s robot from a parsed SRDF, as

@@ -108,3 +108,19 @@ fn check_trajectory_srv_matches_the_rust_types() {
     }
     assert!(cmake.contains("\"srv/CheckTrajectory.srv\""));
 }
+
+/// A Cyclone DDS peer's `moveit_msgs/CollisionObject` and `PlanningScene` (IDL types built from
+/// `moveit_msgs`' definitions, `tests/peers/moveit_types.py`) serialise to the bytes kept in
+/// `tests/fixtures/planning_scene/`, which the crate's unit tests decode to the same messages
+/// and encode back byte for byte (`src/msgs/planning_scene_tests.rs`).
+#[test]
+fn a_cyclone_peers_planning_scene_bytes_are_the_fixtures() {
+    let answer = common::run_peer("scene_cdr.py", &json!({}));
+    let fixtures = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/planning_scene");
+    for name in ["collision_object", "planning_scene"] {
+        let hex = answer[name].as_str().unwrap_or_else(|| panic!("{name} missing: {answer}"));
+        let peer: Vec<u8> = (0..hex.len()).step_by(2).map(|i| u8::from_str_radix(&hex[i..i + 2], 16).unwrap()).collect();
+        let kept = std::fs::read(format!("{fixtures}/{name}.cdr")).unwrap();
+        assert_eq!(peer, kept, "{name}: the peer's bytes differ from the fixture");
+    }
+}

@@ -10,6 +10,12 @@ mod bounded;
 mod check_states;
 mod definitions;
 pub(crate) mod moveit;
+// The scene's messages are decoded by the tests alone until the node subscribes to MoveIt's
+// scene topics and serves its scene services.
+#[cfg_attr(not(test), expect(dead_code, reason = "the node does not read the planning scene yet"))]
+pub(crate) mod planning_scene;
+#[cfg(test)]
+mod planning_scene_tests;
 
 pub use self::check_states::{CheckStatesRequest, CheckStatesResponse};
 pub(crate) use self::definitions::{full_definition, COLLISION_REPORT_TYPE, MARKER_ARRAY_TYPE, STRING_TYPE, TF_MESSAGE_TYPE};

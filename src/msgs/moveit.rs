@@ -1,51 +1,26 @@
-//! `moveit_msgs/srv/GetStateValidity` and the closure of messages it carries, as plain serde
-//! structs (field order = wire order, CDR), checked field by field against the `moveit_msgs`
-//! ros2 branch and `common_interfaces` (jazzy): RobotState, AttachedCollisionObject,
-//! CollisionObject, Constraints and its four constraint types, BoundingVolume,
-//! ContactInformation, CostSource, ConstraintEvalResult, shape_msgs, object_recognition_msgs,
-//! sensor_msgs/MultiDOFJointState and the geometry_msgs they use. Constants are given as Rust
-//! constants where the node uses them (they do not travel).
+//! `moveit_msgs/srv/GetStateValidity` and the messages of its closure that the planning scene
+//! does not carry, as plain serde structs (field order = wire order, CDR), checked field by
+//! field against the `moveit_msgs` ros2 branch and `common_interfaces` (jazzy): Constraints and
+//! its four constraint types, BoundingVolume, ContactInformation, CostSource,
+//! ConstraintEvalResult and `geometry_msgs/PoseStamped`. The request's RobotState, its attached
+//! objects and their shapes are the planning scene's (`super::planning_scene`), with the bounds
+//! given there. Constants are given as Rust constants where the node uses them (they do not
+//! travel).
 //!
-//! Every sequence is bounded while it is decoded ([`MAX_MOVEIT_ENTRIES`]), before its elements
-//! are allocated: a request is hostile input like any joint state.
+//! Every other sequence is bounded while it is decoded ([`MAX_MOVEIT_ENTRIES`]), before its
+//! elements are allocated: a request is hostile input like any joint state.
 
-use super::{Header, JointState, JointTrajectory, Point, PoseMsg, Quaternion, Transform, Vector3};
+use super::planning_scene::{RobotStateMsg, ShapeMesh, SolidPrimitive};
+use super::{Header, Point, PoseMsg, Quaternion, Vector3};
 use serde::{Deserialize, Deserializer, Serialize};
 
-/// Entries any sequence of a `GetStateValidity` request may hold when decoded (as many as a
-/// joint state's fields may). A longer one is refused as soon as it runs past.
+/// Entries a sequence of a `GetStateValidity` request outside its robot state may hold when
+/// decoded (as many as a joint state's fields may). A longer one is refused as soon as it runs past.
 pub const MAX_MOVEIT_ENTRIES: usize = 65_536;
 
 /// A sequence of at most [`MAX_MOVEIT_ENTRIES`], refused as soon as it runs past.
 fn bounded<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
     super::bounded::bounded_vec(d, MAX_MOVEIT_ENTRIES, "GetStateValidity sequence")
-}
-
-/// `float64[<=3]`: a bounded sequence of at most 3 on the wire, refused past that.
-fn at_most_3<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
-    let v: Vec<f64> = bounded(d)?;
-    if v.len() > 3 {
-        return Err(serde::de::Error::custom(format!("SolidPrimitive.dimensions has {} entries; at most 3 allowed", v.len())));
-    }
-    Ok(v)
-}
-
-/// `geometry_msgs/msg/Twist`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Twist {
-    /// Linear velocity.
-    pub linear: Vector3,
-    /// Angular velocity.
-    pub angular: Vector3,
-}
-
-/// `geometry_msgs/msg/Wrench`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Wrench {
-    /// Force.
-    pub force: Vector3,
-    /// Torque.
-    pub torque: Vector3,
 }
 
 /// `geometry_msgs/msg/PoseStamped`.
@@ -55,162 +30,6 @@ pub struct PoseStamped {
     pub header: Header,
     /// Pose.
     pub pose: PoseMsg,
-}
-
-/// `geometry_msgs/msg/Point32`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Point32 {
-    /// x.
-    pub x: f32,
-    /// y.
-    pub y: f32,
-    /// z.
-    pub z: f32,
-}
-
-/// `geometry_msgs/msg/Polygon`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Polygon {
-    /// Vertices.
-    #[serde(deserialize_with = "bounded")]
-    pub points: Vec<Point32>,
-}
-
-/// `sensor_msgs/msg/MultiDOFJointState`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct MultiDofJointState {
-    /// Header.
-    pub header: Header,
-    /// Joint names.
-    #[serde(deserialize_with = "bounded")]
-    pub joint_names: Vec<String>,
-    /// One transform per joint.
-    #[serde(deserialize_with = "bounded")]
-    pub transforms: Vec<Transform>,
-    /// Velocities.
-    #[serde(deserialize_with = "bounded")]
-    pub twist: Vec<Twist>,
-    /// Wrenches.
-    #[serde(deserialize_with = "bounded")]
-    pub wrench: Vec<Wrench>,
-}
-
-/// `shape_msgs/msg/SolidPrimitive` (with the `polygon` field of humble and later).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct SolidPrimitive {
-    /// BOX=1, SPHERE=2, CYLINDER=3, CONE=4, PRISM=5.
-    #[serde(rename = "type")]
-    pub kind: u8,
-    /// `float64[<=3]`.
-    #[serde(deserialize_with = "at_most_3")]
-    pub dimensions: Vec<f64>,
-    /// The base of a PRISM.
-    pub polygon: Polygon,
-}
-
-/// `shape_msgs/msg/MeshTriangle`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct MeshTriangle {
-    /// `uint32[3]` (a fixed array: no length on the wire).
-    pub vertex_indices: [u32; 3],
-}
-
-/// `shape_msgs/msg/Mesh`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ShapeMesh {
-    /// Triangles.
-    #[serde(deserialize_with = "bounded")]
-    pub triangles: Vec<MeshTriangle>,
-    /// Vertices.
-    #[serde(deserialize_with = "bounded")]
-    pub vertices: Vec<Point>,
-}
-
-/// `shape_msgs/msg/Plane`: `float64[4] coef` (a fixed array).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Plane {
-    /// ax + by + cz + d = 0.
-    pub coef: [f64; 4],
-}
-
-/// `object_recognition_msgs/msg/ObjectType`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ObjectType {
-    /// Key.
-    pub key: String,
-    /// Database.
-    pub db: String,
-}
-
-/// `moveit_msgs/msg/CollisionObject`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct CollisionObject {
-    /// Header.
-    pub header: Header,
-    /// Pose of the object.
-    pub pose: PoseMsg,
-    /// Id.
-    pub id: String,
-    /// Type.
-    #[serde(rename = "type")]
-    pub kind: ObjectType,
-    /// Primitives.
-    #[serde(deserialize_with = "bounded")]
-    pub primitives: Vec<SolidPrimitive>,
-    /// Their poses.
-    #[serde(deserialize_with = "bounded")]
-    pub primitive_poses: Vec<PoseMsg>,
-    /// Meshes.
-    #[serde(deserialize_with = "bounded")]
-    pub meshes: Vec<ShapeMesh>,
-    /// Their poses.
-    #[serde(deserialize_with = "bounded")]
-    pub mesh_poses: Vec<PoseMsg>,
-    /// Planes.
-    #[serde(deserialize_with = "bounded")]
-    pub planes: Vec<Plane>,
-    /// Their poses.
-    #[serde(deserialize_with = "bounded")]
-    pub plane_poses: Vec<PoseMsg>,
-    /// Subframe names.
-    #[serde(deserialize_with = "bounded")]
-    pub subframe_names: Vec<String>,
-    /// Subframe poses.
-    #[serde(deserialize_with = "bounded")]
-    pub subframe_poses: Vec<PoseMsg>,
-    /// `byte`: ADD=0, REMOVE=1, APPEND=2, MOVE=3.
-    pub operation: u8,
-}
-
-/// `moveit_msgs/msg/AttachedCollisionObject`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct AttachedCollisionObject {
-    /// The link it is attached to.
-    pub link_name: String,
-    /// The object.
-    pub object: CollisionObject,
-    /// Links it may touch.
-    #[serde(deserialize_with = "bounded")]
-    pub touch_links: Vec<String>,
-    /// Posture on detaching.
-    pub detach_posture: JointTrajectory,
-    /// Weight (kg).
-    pub weight: f64,
-}
-
-/// `moveit_msgs/msg/RobotState`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct RobotStateMsg {
-    /// Single-DOF joints.
-    pub joint_state: JointState,
-    /// Multi-DOF joints.
-    pub multi_dof_joint_state: MultiDofJointState,
-    /// Attached collision objects.
-    #[serde(deserialize_with = "bounded")]
-    pub attached_collision_objects: Vec<AttachedCollisionObject>,
-    /// Whether the state is a difference to the current one (the node applies it on top of the
-    /// current state either way, as `move_group` does).
-    pub is_diff: bool,
 }
 
 /// `moveit_msgs/msg/JointConstraint`.

@@ -255,7 +255,8 @@ fn contact(c: &ReportContact, frame: &str, stamp: Time) -> ContactInformation {
 mod tests {
     use super::*;
     use crate::model::{MissingJoint, Params};
-    use crate::msgs::moveit::{AttachedCollisionObject, JointConstraint, RobotStateMsg};
+    use crate::msgs::moveit::JointConstraint;
+    use crate::msgs::planning_scene::{AttachedCollisionObject, RobotStateMsg};
     use crate::msgs::{JointState, Transform};
 
     /// The arm with nothing received yet.

@@ -1,9 +1,11 @@
-"""Cyclone DDS IDL types for moveit_msgs/srv/GetStateValidity and everything it carries, built from
-this project's own field lists (below), for tests/peers/validity_peer.py. The lists were checked
-field by field against the moveit_msgs ros2 branch (msg/*.msg, srv/GetStateValidity.srv) and
-common_interfaces (jazzy: shape_msgs, sensor_msgs, geometry_msgs, trajectory_msgs), plus
-object_recognition_msgs (ros2 branch), diagnostic_msgs and builtin_interfaces; constants are left out (they do not travel). Field order is
-wire order; the Rust side is src/msgs/moveit.rs.
+"""Cyclone DDS IDL types for moveit_msgs/srv/GetStateValidity and moveit_msgs/msg/PlanningScene and
+everything they carry, built from this project's own field lists (below), for
+tests/peers/validity_peer.py and tests/peers/scene_cdr.py. The lists were checked field by field
+against the moveit_msgs ros2 branch (msg/*.msg, srv/GetStateValidity.srv) and common_interfaces
+(jazzy: shape_msgs, sensor_msgs, geometry_msgs, trajectory_msgs, std_msgs), plus
+object_recognition_msgs and octomap_msgs (ros2 branches), diagnostic_msgs and builtin_interfaces;
+constants are left out (they do not travel). Field order is wire order; the Rust side is
+src/msgs/moveit.rs and src/msgs/planning_scene.rs.
 
 A field is "TYPE NAME"; TYPE is a primitive, a full "pkg/Type" name, or either followed by "[]"
 (sequence), "[<=N]" (bounded sequence) or "[N]" (fixed array)."""
@@ -86,6 +88,22 @@ FIELDS = [
      " uint32 body_type_1; string contact_body_2; uint32 body_type_2"),
     ("moveit_msgs/msg/CostSource", "float64 cost_density; geometry_msgs/Vector3 aabb_min; geometry_msgs/Vector3 aabb_max"),
     ("moveit_msgs/msg/ConstraintEvalResult", "bool result; float64 distance"),
+    # The rest of moveit_msgs/msg/PlanningScene.
+    ("std_msgs/msg/ColorRGBA", "float32 r; float32 g; float32 b; float32 a"),
+    ("geometry_msgs/msg/TransformStamped", "std_msgs/Header header; string child_frame_id; geometry_msgs/Transform transform"),
+    ("octomap_msgs/msg/Octomap", "std_msgs/Header header; bool binary; string id; float64 resolution; int8[] data"),
+    ("octomap_msgs/msg/OctomapWithPose", "std_msgs/Header header; geometry_msgs/Pose origin; octomap_msgs/Octomap octomap"),
+    ("moveit_msgs/msg/PlanningSceneWorld", "moveit_msgs/CollisionObject[] collision_objects; octomap_msgs/OctomapWithPose octomap"),
+    ("moveit_msgs/msg/AllowedCollisionEntry", "bool[] enabled"),
+    ("moveit_msgs/msg/AllowedCollisionMatrix",
+     "string[] entry_names; moveit_msgs/AllowedCollisionEntry[] entry_values; string[] default_entry_names; bool[] default_entry_values"),
+    ("moveit_msgs/msg/LinkPadding", "string link_name; float64 padding"),
+    ("moveit_msgs/msg/LinkScale", "string link_name; float64 scale"),
+    ("moveit_msgs/msg/ObjectColor", "string id; std_msgs/ColorRGBA color"),
+    ("moveit_msgs/msg/PlanningScene",
+     "string name; moveit_msgs/RobotState robot_state; string robot_model_name; geometry_msgs/TransformStamped[] fixed_frame_transforms;"
+     " moveit_msgs/AllowedCollisionMatrix allowed_collision_matrix; moveit_msgs/LinkPadding[] link_padding;"
+     " moveit_msgs/LinkScale[] link_scale; moveit_msgs/ObjectColor[] object_colors; moveit_msgs/PlanningSceneWorld world; bool is_diff"),
     # Cyclone's request/reply mapping: a (guid, seq) header before the .srv's fields.
     ("moveit_msgs/srv/GetStateValidity_Request",
      "uint64 guid; int64 seq; moveit_msgs/RobotState robot_state; string group_name; moveit_msgs/Constraints constraints"),
@@ -94,7 +112,7 @@ FIELDS = [
      " moveit_msgs/ConstraintEvalResult[] constraint_result"),
 ]
 
-PRIMS = {"bool": bool, "byte": t.byte, "uint8": t.uint8, "int32": t.int32, "uint32": t.uint32, "int64": t.int64, "uint64": t.uint64,
+PRIMS = {"bool": bool, "byte": t.byte, "int8": t.int8, "uint8": t.uint8, "int32": t.int32, "uint32": t.uint32, "int64": t.int64, "uint64": t.uint64,
          "float32": t.float32, "float64": t.float64, "string": str}
 TYPES = {}
 
