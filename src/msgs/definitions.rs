@@ -174,105 +174,105 @@ const COLLISION_OBJECT_DEPS: [(&str, &str); 12] = [
     ("shape_msgs/Plane", PLANE),
 ];
 
+const COLLISION_REPORT_DEPS: [(&str, &str); 6] = [
+    ("std_msgs/Header", HEADER),
+    ("builtin_interfaces/Time", TIME),
+    ("thickness_collision_msgs/Contact", CONTACT),
+    ("geometry_msgs/Point", POINT),
+    ("geometry_msgs/Vector3", VECTOR3),
+    ("thickness_collision_msgs/Clearance", CLEARANCE),
+];
+
+const MARKER_ARRAY_DEPS: [(&str, &str); 12] = [
+    ("visualization_msgs/Marker", MARKER),
+    ("std_msgs/Header", HEADER),
+    ("builtin_interfaces/Time", TIME),
+    ("geometry_msgs/Pose", POSE),
+    ("geometry_msgs/Point", POINT),
+    ("geometry_msgs/Quaternion", QUATERNION),
+    ("geometry_msgs/Vector3", VECTOR3),
+    ("std_msgs/ColorRGBA", COLOR_RGBA),
+    ("builtin_interfaces/Duration", DURATION),
+    ("sensor_msgs/CompressedImage", COMPRESSED_IMAGE),
+    ("visualization_msgs/UVCoordinate", UV_COORDINATE),
+    ("visualization_msgs/MeshFile", MESH_FILE),
+];
+
+const TF_MESSAGE_DEPS: [(&str, &str); 6] = [
+    ("geometry_msgs/TransformStamped", TRANSFORM_STAMPED),
+    ("std_msgs/Header", HEADER),
+    ("builtin_interfaces/Time", TIME),
+    ("geometry_msgs/Transform", TRANSFORM),
+    ("geometry_msgs/Vector3", VECTOR3),
+    ("geometry_msgs/Quaternion", QUATERNION),
+];
+
+const PLANNING_SCENE_DEPS: [(&str, &str); 34] = [
+    ("moveit_msgs/RobotState", ROBOT_STATE),
+    ("sensor_msgs/JointState", JOINT_STATE),
+    ("std_msgs/Header", HEADER),
+    ("builtin_interfaces/Time", TIME),
+    ("sensor_msgs/MultiDOFJointState", MULTI_DOF_JOINT_STATE),
+    ("geometry_msgs/Transform", TRANSFORM),
+    ("geometry_msgs/Vector3", VECTOR3),
+    ("geometry_msgs/Quaternion", QUATERNION),
+    ("geometry_msgs/Twist", TWIST),
+    ("geometry_msgs/Wrench", WRENCH),
+    ("moveit_msgs/AttachedCollisionObject", ATTACHED_COLLISION_OBJECT),
+    ("moveit_msgs/CollisionObject", COLLISION_OBJECT),
+    ("geometry_msgs/Pose", POSE),
+    ("geometry_msgs/Point", POINT),
+    ("object_recognition_msgs/ObjectType", OBJECT_TYPE),
+    ("shape_msgs/SolidPrimitive", SOLID_PRIMITIVE),
+    ("geometry_msgs/Polygon", POLYGON),
+    ("geometry_msgs/Point32", POINT32),
+    ("shape_msgs/Mesh", MESH),
+    ("shape_msgs/MeshTriangle", MESH_TRIANGLE),
+    ("shape_msgs/Plane", PLANE),
+    ("trajectory_msgs/JointTrajectory", JOINT_TRAJECTORY),
+    ("trajectory_msgs/JointTrajectoryPoint", JOINT_TRAJECTORY_POINT),
+    ("builtin_interfaces/Duration", DURATION),
+    ("geometry_msgs/TransformStamped", TRANSFORM_STAMPED),
+    ("moveit_msgs/AllowedCollisionMatrix", ALLOWED_COLLISION_MATRIX),
+    ("moveit_msgs/AllowedCollisionEntry", ALLOWED_COLLISION_ENTRY),
+    ("moveit_msgs/LinkPadding", LINK_PADDING),
+    ("moveit_msgs/LinkScale", LINK_SCALE),
+    ("moveit_msgs/ObjectColor", OBJECT_COLOR),
+    ("std_msgs/ColorRGBA", COLOR_RGBA),
+    ("moveit_msgs/PlanningSceneWorld", PLANNING_SCENE_WORLD),
+    ("octomap_msgs/OctomapWithPose", OCTOMAP_WITH_POSE),
+    ("octomap_msgs/Octomap", OCTOMAP),
+];
+
+const ATTACHED_COLLISION_OBJECT_AFTER: [(&str, &str); 3] = [
+    ("trajectory_msgs/JointTrajectory", JOINT_TRAJECTORY),
+    ("trajectory_msgs/JointTrajectoryPoint", JOINT_TRAJECTORY_POINT),
+    ("builtin_interfaces/Duration", DURATION),
+];
+
+const PLANNING_SCENE_WORLD_AFTER: [(&str, &str); 2] = [("octomap_msgs/OctomapWithPose", OCTOMAP_WITH_POSE), ("octomap_msgs/Octomap", OCTOMAP)];
+
 /// The full `ros2msg` definition of a type this crate writes or reads, or `None`.
 pub(crate) fn full_definition(type_name: &str) -> Option<String> {
     // A collision object and its dependencies, then the rest (the two types that hold one).
-    let with_object: Vec<(&str, &str)>;
+    let with_object =
+        |after: &[(&'static str, &'static str)]| [&[("moveit_msgs/CollisionObject", COLLISION_OBJECT)][..], &COLLISION_OBJECT_DEPS, after].concat();
+    let held;
     let (main, deps): (&str, &[(&str, &str)]) = match type_name {
-        COLLISION_REPORT_TYPE => (
-            COLLISION_REPORT,
-            &[
-                ("std_msgs/Header", HEADER),
-                ("builtin_interfaces/Time", TIME),
-                ("thickness_collision_msgs/Contact", CONTACT),
-                ("geometry_msgs/Point", POINT),
-                ("geometry_msgs/Vector3", VECTOR3),
-                ("thickness_collision_msgs/Clearance", CLEARANCE),
-            ],
-        ),
-        MARKER_ARRAY_TYPE => (
-            MARKER_ARRAY,
-            &[
-                ("visualization_msgs/Marker", MARKER),
-                ("std_msgs/Header", HEADER),
-                ("builtin_interfaces/Time", TIME),
-                ("geometry_msgs/Pose", POSE),
-                ("geometry_msgs/Point", POINT),
-                ("geometry_msgs/Quaternion", QUATERNION),
-                ("geometry_msgs/Vector3", VECTOR3),
-                ("std_msgs/ColorRGBA", COLOR_RGBA),
-                ("builtin_interfaces/Duration", DURATION),
-                ("sensor_msgs/CompressedImage", COMPRESSED_IMAGE),
-                ("visualization_msgs/UVCoordinate", UV_COORDINATE),
-                ("visualization_msgs/MeshFile", MESH_FILE),
-            ],
-        ),
-        TF_MESSAGE_TYPE => (
-            TF_MESSAGE,
-            &[
-                ("geometry_msgs/TransformStamped", TRANSFORM_STAMPED),
-                ("std_msgs/Header", HEADER),
-                ("builtin_interfaces/Time", TIME),
-                ("geometry_msgs/Transform", TRANSFORM),
-                ("geometry_msgs/Vector3", VECTOR3),
-                ("geometry_msgs/Quaternion", QUATERNION),
-            ],
-        ),
+        COLLISION_REPORT_TYPE => (COLLISION_REPORT, &COLLISION_REPORT_DEPS),
+        MARKER_ARRAY_TYPE => (MARKER_ARRAY, &MARKER_ARRAY_DEPS),
+        TF_MESSAGE_TYPE => (TF_MESSAGE, &TF_MESSAGE_DEPS),
         STRING_TYPE => (STRING, &[]),
         COLLISION_OBJECT_TYPE => (COLLISION_OBJECT, &COLLISION_OBJECT_DEPS),
         ATTACHED_COLLISION_OBJECT_TYPE => {
-            let after: &[(&str, &str)] = &[
-                ("trajectory_msgs/JointTrajectory", JOINT_TRAJECTORY),
-                ("trajectory_msgs/JointTrajectoryPoint", JOINT_TRAJECTORY_POINT),
-                ("builtin_interfaces/Duration", DURATION),
-            ];
-            with_object = [&[("moveit_msgs/CollisionObject", COLLISION_OBJECT)][..], &COLLISION_OBJECT_DEPS, after].concat();
-            (ATTACHED_COLLISION_OBJECT, &with_object)
+            held = with_object(&ATTACHED_COLLISION_OBJECT_AFTER);
+            (ATTACHED_COLLISION_OBJECT, &held)
         }
         PLANNING_SCENE_WORLD_TYPE => {
-            let after: &[(&str, &str)] = &[("octomap_msgs/OctomapWithPose", OCTOMAP_WITH_POSE), ("octomap_msgs/Octomap", OCTOMAP)];
-            with_object = [&[("moveit_msgs/CollisionObject", COLLISION_OBJECT)][..], &COLLISION_OBJECT_DEPS, after].concat();
-            (PLANNING_SCENE_WORLD, &with_object)
+            held = with_object(&PLANNING_SCENE_WORLD_AFTER);
+            (PLANNING_SCENE_WORLD, &held)
         }
-        PLANNING_SCENE_TYPE => (
-            PLANNING_SCENE,
-            &[
-                ("moveit_msgs/RobotState", ROBOT_STATE),
-                ("sensor_msgs/JointState", JOINT_STATE),
-                ("std_msgs/Header", HEADER),
-                ("builtin_interfaces/Time", TIME),
-                ("sensor_msgs/MultiDOFJointState", MULTI_DOF_JOINT_STATE),
-                ("geometry_msgs/Transform", TRANSFORM),
-                ("geometry_msgs/Vector3", VECTOR3),
-                ("geometry_msgs/Quaternion", QUATERNION),
-                ("geometry_msgs/Twist", TWIST),
-                ("geometry_msgs/Wrench", WRENCH),
-                ("moveit_msgs/AttachedCollisionObject", ATTACHED_COLLISION_OBJECT),
-                ("moveit_msgs/CollisionObject", COLLISION_OBJECT),
-                ("geometry_msgs/Pose", POSE),
-                ("geometry_msgs/Point", POINT),
-                ("object_recognition_msgs/ObjectType", OBJECT_TYPE),
-                ("shape_msgs/SolidPrimitive", SOLID_PRIMITIVE),
-                ("geometry_msgs/Polygon", POLYGON),
-                ("geometry_msgs/Point32", POINT32),
-                ("shape_msgs/Mesh", MESH),
-                ("shape_msgs/MeshTriangle", MESH_TRIANGLE),
-                ("shape_msgs/Plane", PLANE),
-                ("trajectory_msgs/JointTrajectory", JOINT_TRAJECTORY),
-                ("trajectory_msgs/JointTrajectoryPoint", JOINT_TRAJECTORY_POINT),
-                ("builtin_interfaces/Duration", DURATION),
-                ("geometry_msgs/TransformStamped", TRANSFORM_STAMPED),
-                ("moveit_msgs/AllowedCollisionMatrix", ALLOWED_COLLISION_MATRIX),
-                ("moveit_msgs/AllowedCollisionEntry", ALLOWED_COLLISION_ENTRY),
-                ("moveit_msgs/LinkPadding", LINK_PADDING),
-                ("moveit_msgs/LinkScale", LINK_SCALE),
-                ("moveit_msgs/ObjectColor", OBJECT_COLOR),
-                ("std_msgs/ColorRGBA", COLOR_RGBA),
-                ("moveit_msgs/PlanningSceneWorld", PLANNING_SCENE_WORLD),
-                ("octomap_msgs/OctomapWithPose", OCTOMAP_WITH_POSE),
-                ("octomap_msgs/Octomap", OCTOMAP),
-            ],
-        ),
+        PLANNING_SCENE_TYPE => (PLANNING_SCENE, &PLANNING_SCENE_DEPS),
         _ => return None,
     };
     let mut out = main.trim_end().to_owned();
