@@ -9,12 +9,18 @@
 //! - [`PipelineAccess`]: the node's request services on a [`Pipeline`] (`check_states`,
 //!   `check_trajectory` off the loop, MoveIt's `check_state_validity`), with the MoveIt messages
 //!   a request is built from;
-//! - [`build_self_pairs`]: the self-collision pairs of a parsed SRDF.
+//! - [`build_self_pairs`]: the self-collision pairs of a parsed SRDF;
+//! - [`planning_scene_round_trip`]: the planning-scene messages through their bounded decoders.
 
 use crate::checker::{Checker, SelfPairs};
 use crate::model::Srdf;
+use crate::msgs::planning_scene::{
+    ApplyPlanningSceneRequest, CollisionObject, GetPlanningSceneRequest, GetPlanningSceneResponse, PlanningScene, PlanningSceneWorld,
+};
 use crate::msgs::{CollisionReport, JointState, JointTrajectory};
 use crate::pipeline::{Pipeline, TrajectoryJob};
+use crate::replay::{decode_cdr, encode_cdr_le};
+use serde::{de::DeserializeOwned, Serialize};
 
 pub use crate::model::mesh_file::parse_mesh;
 pub use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse, JointConstraint};
@@ -51,4 +57,35 @@ impl PipelineAccess for Pipeline {
     fn check_validity(&self, req: &GetStateValidityRequest) -> (GetStateValidityResponse, Option<String>) {
         Pipeline::check_validity(self, req)
     }
+}
+
+/// The planning-scene messages a deployment's graph may send: `data`'s first byte picks the type
+/// (CollisionObject, AttachedCollisionObject, PlanningScene, PlanningSceneWorld, the
+/// ApplyPlanningScene request, the GetPlanningScene request and response), the rest is its CDR
+/// payload. What decodes must encode to bytes that decode and encode to the same bytes (panics
+/// otherwise): nothing a decoder accepts is lost or changed on the way back out. Returns whether
+/// it decoded.
+pub fn planning_scene_round_trip(data: &[u8]) -> bool {
+    let Some((&kind, payload)) = data.split_first() else {
+        return false;
+    };
+    match kind % 7 {
+        0 => round_trip::<CollisionObject>(payload),
+        1 => round_trip::<AttachedCollisionObject>(payload),
+        2 => round_trip::<PlanningScene>(payload),
+        3 => round_trip::<PlanningSceneWorld>(payload),
+        4 => round_trip::<ApplyPlanningSceneRequest>(payload),
+        5 => round_trip::<GetPlanningSceneRequest>(payload),
+        _ => round_trip::<GetPlanningSceneResponse>(payload),
+    }
+}
+
+fn round_trip<T: Serialize + DeserializeOwned>(payload: &[u8]) -> bool {
+    let Ok(message) = decode_cdr::<T>(payload) else {
+        return false;
+    };
+    let bytes = encode_cdr_le(&message);
+    let again = decode_cdr::<T>(&bytes).unwrap_or_else(|e| panic!("a decoded message encodes to bytes that do not decode: {e}"));
+    assert!(encode_cdr_le(&again) == bytes, "a decoded message does not encode to the same bytes twice");
+    true
 }

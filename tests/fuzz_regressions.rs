@@ -153,3 +153,14 @@ fn records_split_back() {
     assert_eq!(split_records(&[4, 9, 0, 7]), vec![(CdrKind::CheckStates, &[7u8][..])]);
     assert_eq!(split_records(&[6]), vec![(CdrKind::JointStates, &[][..])]);
 }
+
+/// The planning-scene seeds (the bytes Cyclone DDS wrote) decode as the types their first byte
+/// names, and round-trip: a seed that no longer decodes would test only the refusal.
+#[test]
+fn planning_scene_seeds_decode() {
+    let seeds: Vec<_> = seeds().into_iter().filter(|s| s.0 == "planning_scene").collect();
+    assert_eq!(seeds.len(), 2);
+    for (_, name, bytes) in seeds {
+        assert!(thickness_collision::fuzz_access::planning_scene_round_trip(&bytes), "{name} does not decode");
+    }
+}

@@ -234,3 +234,9 @@ pub fn bag_mcap(data: &[u8]) {
 pub fn bag_sqlite(data: &[u8]) {
     bag(data, "fuzz.db3");
 }
+
+/// A planning-scene message (first byte: which type), through its bounded decoder and back: see
+/// `fuzz_access::planning_scene_round_trip`.
+pub fn planning_scene(data: &[u8]) {
+    let _ = thickness_collision::fuzz_access::planning_scene_round_trip(data);
+}

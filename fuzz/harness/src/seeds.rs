@@ -79,6 +79,15 @@ pub fn seeds() -> Vec<Seed> {
     state_line_seeds(&mut out);
     trajectory_seeds(&mut out);
     validity_seeds(&mut out);
+    // Planning-scene messages: the bytes Cyclone DDS wrote for the interface test, behind their
+    // type byte.
+    let scene_bytes: [(u8, &str, &[u8]); 2] = [
+        (0, "collision_object.cdr", include_bytes!("../../../tests/fixtures/planning_scene/collision_object.cdr")),
+        (2, "planning_scene.cdr", include_bytes!("../../../tests/fixtures/planning_scene/planning_scene.cdr")),
+    ];
+    for (kind, file, bytes) in scene_bytes {
+        out.push(("planning_scene", file.into(), [&[kind][..], bytes].concat()));
+    }
     // Parameters: the bundled file and the defaults written out.
     let params = std::fs::read(bundled_config_dir().join("params.yaml")).unwrap_or_default();
     out.push(("params_yaml", "params.yaml".into(), params));
