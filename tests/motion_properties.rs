@@ -118,7 +118,7 @@ fn motions_agree_with_dense_sampling() {
             }
         } else {
             let object = c.scene().objects().iter().find(|o| o.name == contact.object_name).unwrap();
-            let other: Box<dyn parry3d_f64::shape::Shape> = match &object.body {
+            let other: Box<dyn parry3d_f64::shape::Shape> = match &*object.body {
                 ObjectBody::Surface { area, .. } => {
                     let cell = area.cells.iter().find(|cell| cell.triangle == contact.triangle).unwrap();
                     Box::new(ConvexPolyhedron::from_convex_hull(&cell.distinct_vertices()).unwrap())

@@ -7,6 +7,7 @@ use super::self_pairs::SelfPairs;
 use crate::collision::{CollideSettings, Scene, Target, TargetReport};
 use crate::model::{Params, RobotModel};
 use nalgebra::Isometry3;
+use std::collections::BTreeMap;
 use std::sync::{Arc, OnceLock};
 
 /// What was loaded (printed by the CLI and the node at start).
@@ -54,6 +55,9 @@ pub struct Checker {
     pub(super) moving: Vec<bool>,
     /// The scene's first objects are the environment's; planning-scene objects follow.
     pub(super) environment_objects: usize,
+    /// The environment's links by name, with their poses in the world: frames a planning-scene
+    /// object may be given in.
+    pub(super) environment_frames: Arc<BTreeMap<String, crate::math::Pose>>,
 }
 
 impl Checker {
@@ -97,6 +101,11 @@ impl Checker {
     /// elsewhere (the pipeline's, for a robot that comes as a description).
     pub(crate) fn set_semantic_file_name(&mut self, file: String) {
         self.params.robot_semantic_file = file;
+    }
+
+    /// The pose in the world of the environment's link `name`.
+    pub(crate) fn environment_frame(&self, name: &str) -> Option<crate::math::Pose> {
+        self.environment_frames.get(name).copied()
     }
 
     /// The self-collision pairs and the SRDF they come from.

@@ -7,13 +7,15 @@ use super::checker_error::CheckerError;
 use super::geometry_shapes::{primitive_shape, MeshCache};
 use super::link_targets::LinkTargets;
 use super::self_pairs::SelfPairs;
-use crate::collision::{ConvexHull, Scene, TargetShape};
+use crate::collision::{ConvexHull, ObjectBody, Scene, TargetShape};
 use crate::math::pose_from_isometry;
+use crate::math::Pose;
 use crate::mesh::{MeshTopology, TopologySettings};
 use crate::model::MeshData;
 use crate::model::{GeometrySpec, ModelError, PackageResolver, Params, RobotModel, Srdf};
 use crate::thickness::{Side, ThicknessArea, ThicknessSettings};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
@@ -93,7 +95,7 @@ impl Checker {
         let started = Instant::now();
         let mut cache = MeshCache::default();
         let mut summary = BuildSummary { robot_source, environment_source, robot_links: robot.links.len(), ..Default::default() };
-        let scene = environment_scene(&params, &env, &mut cache, &mut summary)?;
+        let (scene, environment_frames) = environment_scene(&params, &env, &mut cache, &mut summary)?;
         let targets = robot_targets(&params, &robot, &mut cache, &summary.robot_source)?;
         if targets.is_empty() {
             return Err(no_checked_link(&params, &robot, &summary.robot_source));
@@ -117,6 +119,7 @@ impl Checker {
             self_pairs: SelfPairs::default(),
             moving,
             environment_objects: scene_objects,
+            environment_frames: Arc::new(environment_frames),
         })
     }
 
@@ -148,20 +151,26 @@ impl Checker {
     /// targets and scene are shared or copied, not loaded again (an SRDF that arrives on its topic
     /// after the robot must not cost a second build of a million-cell world).
     pub(crate) fn with_other_semantic(&self, text: &str, source: &str) -> Result<Checker, CheckerError> {
-        let checker = Checker {
+        self.rebuilt(Arc::clone(&self.scene), self.allowed.clone(), SelfPairs::default()).with_semantic(text, source)
+    }
+
+    /// This checker with another scene, allowed matrix and self pairs; robot, targets and
+    /// motion bounds shared or copied.
+    pub(super) fn rebuilt(&self, scene: Arc<Scene>, allowed: Vec<Vec<bool>>, self_pairs: SelfPairs) -> Checker {
+        Checker {
             params: self.params.clone(),
             robot: self.robot.clone(),
             targets: self.targets.clone(),
-            scene: Arc::clone(&self.scene),
+            scene,
             summary: self.summary.clone(),
             base: self.base,
-            allowed: self.allowed.clone(),
+            allowed,
             motion: self.motion.clone(),
-            self_pairs: SelfPairs::default(),
+            self_pairs,
             moving: self.moving.clone(),
             environment_objects: self.environment_objects,
-        };
-        checker.with_semantic(text, source)
+            environment_frames: Arc::clone(&self.environment_frames),
+        }
     }
 
     /// As [`Checker::with_semantic`], in place; on error nothing changes.
@@ -173,12 +182,19 @@ impl Checker {
 }
 
 /// The scene of the environment at its zero state: thin surfaces (cells behind open meshes, and
-/// behind closed ones not checked as solids) and convex solids.
-fn environment_scene(params: &Params, env: &RobotModel, cache: &mut MeshCache, summary: &mut BuildSummary) -> Result<Scene, CheckerError> {
+/// behind closed ones not checked as solids) and convex solids; and the world pose of each of
+/// its links (frames planning-scene objects may be placed in).
+fn environment_scene(
+    params: &Params,
+    env: &RobotModel,
+    cache: &mut MeshCache,
+    summary: &mut BuildSummary,
+) -> Result<(Scene, BTreeMap<String, Pose>), CheckerError> {
     let mut scene = Scene::new();
     let env_poses = env
         .forward_kinematics(&vec![0.0; env.joints.len()], &Isometry3::identity())
         .map_err(|e| CheckerError::Model(ModelError::Structure { file: summary.environment_source.clone(), message: e.to_string() }))?;
+    let frames = env.links.iter().zip(&env_poses).map(|(l, p)| (l.name.clone(), pose_from_isometry(p))).collect();
     for (li, link) in env.links.iter().enumerate() {
         for g in &link.geometry {
             let pose = pose_from_isometry(&(env_poses[li] * g.origin));
@@ -209,7 +225,7 @@ fn environment_scene(params: &Params, env: &RobotModel, cache: &mut MeshCache, s
             }
         }
     }
-    Ok(scene)
+    Ok((scene, frames))
 }
 
 /// One environment mesh into `scene`: a solid (its convex hull) when closed and named in
@@ -222,22 +238,26 @@ pub(super) fn add_environment_mesh(
     data: &MeshData,
     summary: &mut BuildSummary,
 ) -> Result<(), String> {
+    let _ = scene.add_body(name.to_owned(), pose, Arc::new(environment_mesh_body(params, name, data, summary)?));
+    Ok(())
+}
+
+/// What [`add_environment_mesh`] adds, in the object's frame: its hull, or its cells.
+pub(super) fn environment_mesh_body(params: &Params, name: &str, data: &MeshData, summary: &mut BuildSummary) -> Result<ObjectBody, String> {
     let mesh = MeshTopology::build(&data.vertices, &data.triangles, &TopologySettings::default()).map_err(|e| e.to_string())?;
     let closed = mesh.report.boundary_edges == 0 && mesh.report.non_manifold_edges == 0;
     if closed && params.is_solid_hull(name) {
         let hull = ConvexHull::from_points(&data.vertices).ok_or_else(|| "its convex hull is flat".to_owned())?;
-        let _ = scene.add_solid(name.to_owned(), pose, TargetShape::Polytope(Arc::new(hull)));
         summary.solids += 1;
-    } else {
-        let (thickness, side) = params.surface_settings(name);
-        // A closed mesh has an inside: its cells go inward.
-        let side = if closed { Side::Back } else { side };
-        let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() }).map_err(|e| e.to_string())?;
-        summary.cells += area.cells.len();
-        let _ = scene.add_surface(name.to_owned(), pose, area);
-        summary.thin_surfaces += 1;
+        return Ok(ObjectBody::Solid(TargetShape::Polytope(Arc::new(hull))));
     }
-    Ok(())
+    let (thickness, side) = params.surface_settings(name);
+    // A closed mesh has an inside: its cells go inward.
+    let side = if closed { Side::Back } else { side };
+    let area = ThicknessArea::build(&mesh, &ThicknessSettings { thickness, side, ..Default::default() }).map_err(|e| e.to_string())?;
+    summary.cells += area.cells.len();
+    summary.thin_surfaces += 1;
+    Ok(ObjectBody::surface(area))
 }
 
 /// The targets of the robot's checked links (with geometry and matching `checked_links`), each

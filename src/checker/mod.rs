@@ -20,11 +20,7 @@ mod self_pairs;
 mod state_check;
 mod state_report;
 mod world_motion;
-// The planning scene's objects beside the environment; not yet fed by a door.
-#[allow(dead_code)]
 mod world_objects;
-// The planning scene's objects as the checks see them; not yet fed by a door.
-#[allow(dead_code)]
 mod world_shapes;
 
 pub use self::checker::{BuildSummary, Checker};
@@ -36,4 +32,4 @@ pub use self::link_targets::LinkTargets;
 pub use self::motion_sweep::MotionReport;
 pub use self::self_pairs::SelfPairs;
 pub use self::state_report::{ObjectType, ReportClearance, ReportContact, StateReport};
-pub(crate) use self::world_shapes::WorldShape;
+pub(crate) use self::world_shapes::{BodyCache, WorldShape};

@@ -3,7 +3,7 @@
 use super::checker::{BuildSummary, Checker};
 use super::checker_build::allowed_matrix;
 use super::checker_error::CheckerError;
-use super::world_shapes::{add_world_object, WorldShape};
+use super::world_shapes::{add_world_object, BodyCache, WorldShape};
 use crate::collision::Scene;
 use crate::math::Pose;
 use std::sync::Arc;
@@ -14,7 +14,12 @@ impl Checker {
     /// replaced), each checked exactly as an environment link of its id would be, with the same
     /// `allowed_collisions`. An id that names an environment object or a robot link is refused,
     /// as is a shape that cannot be used. The build summary stays the environment's.
-    pub(crate) fn with_world<'a>(&self, objects: impl IntoIterator<Item = (&'a str, &'a Pose, &'a [(WorldShape, Pose)])>) -> Result<Checker, CheckerError> {
+    /// Mesh bodies come from `cache` when it holds them (those no longer used are forgotten).
+    pub(crate) fn with_world<'a>(
+        &self,
+        objects: impl IntoIterator<Item = (&'a str, &'a Pose, &'a [(WorldShape, Pose)])>,
+        cache: &mut BodyCache,
+    ) -> Result<Checker, CheckerError> {
         let environment = &self.scene.objects()[..self.environment_objects];
         let mut added = Scene::new();
         for (id, pose, shapes) in objects {
@@ -25,22 +30,12 @@ impl Checker {
             if self.robot.link(id).is_some() {
                 return Err(refuse("the id names a link of the robot"));
             }
-            add_world_object(&self.params, &mut added, id, pose, shapes, &mut BuildSummary::default()).map_err(|m| refuse(&m))?;
+            add_world_object(&self.params, &mut added, cache, id, pose, shapes, &mut BuildSummary::default()).map_err(|m| refuse(&m))?;
         }
+        cache.keep_used();
         let scene = self.scene.prefix_with(self.environment_objects, &added);
-        Ok(Checker {
-            params: self.params.clone(),
-            robot: self.robot.clone(),
-            targets: self.targets.clone(),
-            allowed: allowed_matrix(&self.params, &self.targets, &scene),
-            scene: Arc::new(scene),
-            summary: self.summary.clone(),
-            base: self.base,
-            motion: self.motion.clone(),
-            self_pairs: self.self_pairs.clone(),
-            moving: self.moving.clone(),
-            environment_objects: self.environment_objects,
-        })
+        let allowed = allowed_matrix(&self.params, &self.targets, &scene);
+        Ok(self.rebuilt(Arc::new(scene), allowed, self.self_pairs.clone()))
     }
 }
 
@@ -76,9 +71,9 @@ mod tests {
         let sheet: MeshData = read_mesh(&dir.join("fixture.obj"), Vector::ONE).unwrap();
         assert_eq!(sheet.triangles.len(), t.len());
         let sheet_pose = Pose::from_translation(Vector::new(-0.1, 0.2, 0.1));
-        let shapes = [(WorldShape::Box([0.3, 0.2, 0.1]), Pose::from_translation(Vector::new(0.0, 0.0, 0.2))), (WorldShape::Mesh(sheet), sheet_pose)];
+        let shapes = [(WorldShape::Box([0.3, 0.2, 0.1]), Pose::from_translation(Vector::new(0.0, 0.0, 0.2))), (WorldShape::Mesh(Arc::new(sheet)), sheet_pose)];
         let object_pose = Pose::from_translation(Vector::new(0.35, 0.0, 0.3));
-        let with = base.with_world([("fixture", &object_pose, &shapes[..])]).unwrap();
+        let with = base.with_world([("fixture", &object_pose, &shapes[..])], &mut BodyCache::default()).unwrap();
         let env_path = params.environment_path();
         let env_text = std::fs::read_to_string(&env_path).unwrap();
         let link = format!(
@@ -104,7 +99,7 @@ mod tests {
             with_fixture += a.contacts.iter().any(|c| c.object_name == "fixture") as usize;
         }
         assert!(with_fixture > 10 && colliding < 300, "{with_fixture} states touch the fixture, {colliding} of 300 collide");
-        let refusal = |id: &str| base.with_world([(id, &object_pose, &shapes[..])]).err().map(|e| e.to_string()).unwrap_or_default();
+        let refusal = |id: &str| base.with_world([(id, &object_pose, &shapes[..])], &mut BodyCache::default()).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(refusal("guard_sheet").contains("names an object of the environment"), "{}", refusal("guard_sheet"));
         assert!(refusal("base_link").contains("names a link of the robot"), "{}", refusal("base_link"));
     }

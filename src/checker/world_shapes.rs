@@ -4,11 +4,12 @@
 //! its hull; primitives are solids).
 
 use super::checker::BuildSummary;
-use super::checker_build::add_environment_mesh;
+use super::checker_build::environment_mesh_body;
 use super::geometry_shapes::primitive_shape;
-use crate::collision::{ConvexHull, Scene, TargetShape};
+use crate::collision::{ConvexHull, ObjectBody, Scene, TargetShape};
 use crate::math::{Pose, Vector};
 use crate::model::{GeometrySpec, MeshData, Params};
+use crate::thickness::Side;
 use std::sync::Arc;
 
 /// A shape of a planning-scene object, as `shape_msgs` define it (metres, in the shape's frame,
@@ -33,19 +34,106 @@ pub(crate) enum WorldShape {
         height: f64,
         polygon: Vec<[f64; 2]>,
     },
-    /// Triangles whose front is the side their vertices wind counter-clockwise around.
-    Mesh(MeshData),
+    /// Triangles whose front is the side their vertices wind counter-clockwise around (shared:
+    /// a moved object keeps its mesh, and the cells built for it).
+    Mesh(Arc<MeshData>),
 }
 
 /// Corners of the polygon around a cone's base: circumscribed, so that the hull holds the cone
 /// (it reaches at most `radius * (1 / cos(pi / 64) - 1)`, 0.12 % of the radius, beyond it).
 const CONE_SIDES: usize = 64;
 
+/// What decides a mesh's body besides its triangles: thickness, side, and whether it is a hull.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct BodySettings {
+    thickness: f64,
+    side: Side,
+    hull: bool,
+}
+
+struct CachedBody {
+    mesh: Arc<MeshData>,
+    hash: u64,
+    settings: BodySettings,
+    body: Arc<ObjectBody>,
+    used: bool,
+}
+
+/// The bodies built for planning-scene meshes, found again by the mesh (the same one, or one of
+/// the same content) and the settings that decide them, so that moving an object, or adding it
+/// again with the same geometry as `move_group` does after a move, builds no cells. Holds only
+/// the bodies of the scene in force (see [`BodyCache::keep_used`]).
+#[derive(Default)]
+pub(crate) struct BodyCache {
+    entries: Vec<CachedBody>,
+    /// Bodies built (not found) since the cache was made: what a test of the cache counts.
+    pub(crate) built: usize,
+}
+
+impl BodyCache {
+    /// The body for `mesh` under `settings`, built now if no entry has it.
+    fn body(&mut self, params: &Params, id: &str, mesh: &Arc<MeshData>, summary: &mut BuildSummary) -> Result<Arc<ObjectBody>, String> {
+        let (thickness, side) = params.surface_settings(id);
+        let settings = BodySettings { thickness, side, hull: params.is_solid_hull(id) };
+        let same = self.entries.iter().position(|e| e.settings == settings && Arc::ptr_eq(&e.mesh, mesh));
+        let hash = mesh_hash(mesh);
+        let found = same.or_else(|| self.entries.iter().position(|e| e.settings == settings && e.hash == hash && *e.mesh == **mesh));
+        if let Some(i) = found {
+            let entry = &mut self.entries[i];
+            entry.used = true;
+            count(&entry.body, summary);
+            return Ok(Arc::clone(&entry.body));
+        }
+        let body = Arc::new(environment_mesh_body(params, id, mesh, summary)?);
+        self.built += 1;
+        self.entries.push(CachedBody { mesh: Arc::clone(mesh), hash, settings, body: Arc::clone(&body), used: true });
+        Ok(body)
+    }
+
+    /// Forgets the bodies no build used since the last call, and starts the next round.
+    pub(crate) fn keep_used(&mut self) {
+        self.entries.retain(|e| e.used);
+        for e in &mut self.entries {
+            e.used = false;
+        }
+    }
+}
+
+/// A body found in the cache counts in the summary as if it had been built.
+fn count(body: &ObjectBody, summary: &mut BuildSummary) {
+    match body {
+        ObjectBody::Surface { area, .. } => {
+            summary.thin_surfaces += 1;
+            summary.cells += area.cells.len();
+        }
+        ObjectBody::Solid(_) => summary.solids += 1,
+    }
+}
+
+/// A hash of a mesh's content (the bits of its coordinates and its indices): a few hundred
+/// microseconds for 100,000 triangles, against the tens of milliseconds its cells cost.
+fn mesh_hash(mesh: &MeshData) -> u64 {
+    let mut h: u64 = mesh.vertices.len() as u64 ^ ((mesh.triangles.len() as u64) << 32);
+    let mut mix = |x: u64| h = (h.rotate_left(5) ^ x).wrapping_mul(0x517c_c1b7_2722_0a95);
+    for v in &mesh.vertices {
+        mix(v.x.to_bits());
+        mix(v.y.to_bits());
+        mix(v.z.to_bits());
+    }
+    for t in &mesh.triangles {
+        mix(u64::from(t[0]) | (u64::from(t[1]) << 32));
+        mix(u64::from(t[2]));
+    }
+    h
+}
+
 /// Adds one object's shapes to `scene` under the object's id, at `object_pose` and each shape's
-/// pose relative to it. The error is what is wrong with a shape, naming it by its index.
+/// pose relative to it, a mesh's body from `cache` when it holds it. The error is what is wrong
+/// with a shape, naming it by its index.
 pub(crate) fn add_world_object(
     params: &Params,
     scene: &mut Scene,
+    cache: &mut BodyCache,
     id: &str,
     object_pose: &Pose,
     shapes: &[(WorldShape, Pose)],
@@ -54,7 +142,8 @@ pub(crate) fn add_world_object(
     for (k, (shape, pose)) in shapes.iter().enumerate() {
         let pose = *object_pose * *pose;
         if let WorldShape::Mesh(data) = shape {
-            add_environment_mesh(params, scene, id, pose, data, summary).map_err(|e| format!("shape {k} (a mesh): {e}"))?;
+            let body = cache.body(params, id, data, summary).map_err(|e| format!("shape {k} (a mesh): {e}"))?;
+            let _ = scene.add_body(id.to_owned(), pose, body);
             continue;
         }
         let solid = solid(shape).ok_or_else(|| format!("shape {k} ({shape_kind}): not a usable convex shape", shape_kind = kind(shape)))?;
@@ -109,6 +198,7 @@ fn solid(shape: &WorldShape) -> Option<TargetShape> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::checker_build::add_environment_mesh;
     use super::*;
     use crate::collision::{CollideSettings, Target};
     use crate::mesh::generate;
@@ -123,10 +213,10 @@ mod tests {
         let mesh = MeshData { vertices: v.clone(), triangles: t.clone() };
         let object_pose = Pose::from_translation(Vector::new(0.3, -0.2, 0.1));
         let box_pose = Pose::from_translation(Vector::new(0.0, 0.0, 0.5));
-        let shapes = [(WorldShape::Box([0.2, 0.3, 0.4]), box_pose), (WorldShape::Mesh(mesh.clone()), Pose::IDENTITY)];
+        let shapes = [(WorldShape::Box([0.2, 0.3, 0.4]), box_pose), (WorldShape::Mesh(Arc::new(mesh.clone())), Pose::IDENTITY)];
         let mut world = Scene::new();
         let mut summary = BuildSummary::default();
-        add_world_object(&params, &mut world, "shelf", &object_pose, &shapes, &mut summary).unwrap();
+        add_world_object(&params, &mut world, &mut BodyCache::default(), "shelf", &object_pose, &shapes, &mut summary).unwrap();
         assert_eq!((summary.solids, summary.thin_surfaces, summary.cells), (1, 1, t.len()));
         // The twin: what an environment link "shelf" with a box and that mesh builds.
         let mut twin = Scene::new();
@@ -159,8 +249,15 @@ mod tests {
         let prism = solid(&WorldShape::Prism { height: 0.2, polygon: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] }).unwrap();
         assert_eq!(prism.local_aabb().maxs, Vector::new(1.0, 1.0, 0.1));
         let mut scene = Scene::new();
-        let e =
-            add_world_object(&Params::default(), &mut scene, "x", &Pose::IDENTITY, &[(WorldShape::Sphere(-1.0), Pose::IDENTITY)], &mut BuildSummary::default());
+        let e = add_world_object(
+            &Params::default(),
+            &mut scene,
+            &mut BodyCache::default(),
+            "x",
+            &Pose::IDENTITY,
+            &[(WorldShape::Sphere(-1.0), Pose::IDENTITY)],
+            &mut BuildSummary::default(),
+        );
         assert_eq!(e, Err("shape 0 (a sphere): not a usable convex shape".to_owned()));
     }
 }

@@ -26,14 +26,23 @@ pub enum ObjectBody {
     Solid(TargetShape),
 }
 
+impl ObjectBody {
+    /// A thin surface of these cells, in the object's frame; the cells are reordered for the
+    /// broad phase (see [`CellTree::build`]).
+    pub(crate) fn surface(mut area: ThicknessArea) -> ObjectBody {
+        let tree = CellTree::build(&mut area.cells);
+        ObjectBody::Surface { area, tree }
+    }
+}
+
 /// One environment object, fixed in the world.
 pub struct SceneObject {
     /// The object's name (reported in contacts).
     pub name: String,
     /// The pose of the object's frame in the world.
     pub pose: Pose,
-    /// Its geometry.
-    pub body: ObjectBody,
+    /// Its geometry (shared: a planning-scene object that moves keeps its cells).
+    pub body: Arc<ObjectBody>,
     /// Its bounding box in the world (a first, cheap reject per target).
     world_aabb: Aabb,
 }
@@ -41,7 +50,7 @@ pub struct SceneObject {
 impl SceneObject {
     /// The cells, for a thin surface.
     pub fn area(&self) -> Option<&ThicknessArea> {
-        match &self.body {
+        match &*self.body {
             ObjectBody::Surface { area, .. } => Some(area),
             ObjectBody::Solid(_) => None,
         }
@@ -49,7 +58,7 @@ impl SceneObject {
 
     /// Bytes of the broad-phase tree (for memory reports); 0 for solids.
     pub fn bvh_memory(&self) -> usize {
-        match &self.body {
+        match &*self.body {
             ObjectBody::Surface { tree, .. } => tree.memory(),
             ObjectBody::Solid(_) => 0,
         }
@@ -73,17 +82,24 @@ impl Scene {
     /// Adds a thin surface whose cells are given in the object's frame, placed at `pose` in the
     /// world. Returns the object's index.
     /// The area's cells are reordered for the broad phase (see [`CellTree::build`]).
-    pub fn add_surface(&mut self, name: impl Into<String>, pose: Pose, mut area: ThicknessArea) -> usize {
-        let tree = CellTree::build(&mut area.cells);
-        let world_aabb = if tree.is_empty() { Aabb::new_invalid() } else { transformed_box(&tree.root_aabb(), &pose) };
-        self.objects.push(Arc::new(SceneObject { name: name.into(), pose, body: ObjectBody::Surface { area, tree }, world_aabb }));
-        self.objects.len() - 1
+    pub fn add_surface(&mut self, name: impl Into<String>, pose: Pose, area: ThicknessArea) -> usize {
+        self.add_body(name, pose, Arc::new(ObjectBody::surface(area)))
     }
 
     /// Adds a convex solid placed at `pose` in the world. Returns the object's index.
     pub fn add_solid(&mut self, name: impl Into<String>, pose: Pose, shape: TargetShape) -> usize {
-        let world_aabb = transformed_box(&shape.local_aabb(), &pose);
-        self.objects.push(Arc::new(SceneObject { name: name.into(), pose, body: ObjectBody::Solid(shape), world_aabb }));
+        self.add_body(name, pose, Arc::new(ObjectBody::Solid(shape)))
+    }
+
+    /// Adds a body built before (perhaps placed elsewhere in another scene) at `pose`. Returns
+    /// the object's index.
+    pub(crate) fn add_body(&mut self, name: impl Into<String>, pose: Pose, body: Arc<ObjectBody>) -> usize {
+        let world_aabb = match &*body {
+            ObjectBody::Surface { tree, .. } if tree.is_empty() => Aabb::new_invalid(),
+            ObjectBody::Surface { tree, .. } => transformed_box(&tree.root_aabb(), &pose),
+            ObjectBody::Solid(shape) => transformed_box(&shape.local_aabb(), &pose),
+        };
+        self.objects.push(Arc::new(SceneObject { name: name.into(), pose, body, world_aabb }));
         self.objects.len() - 1
     }
 
@@ -143,7 +159,7 @@ impl Scene {
             if !check(oi) || !object.world_aabb.loosened(reach).intersects(&target_aabb) {
                 continue;
             }
-            let flow = match &object.body {
+            let flow = match &*object.body {
                 ObjectBody::Solid(shape) => {
                     // Bounding boxes first: GJK costs ~2 us, and most links are nowhere near.
                     let target_in_object = object.pose.inv_mul(&target.pose);

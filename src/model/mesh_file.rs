@@ -11,7 +11,7 @@ use crate::math::{Real, Vector};
 use std::path::{Path, PathBuf};
 
 /// A mesh read from a file: vertices (metres, after scaling) and triangles in file order.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshData {
     /// Vertices.
     pub vertices: Vec<Vector>,

@@ -155,6 +155,9 @@ pub struct Params {
     pub robot_semantic_file: String,
     /// Check the robot's links against each other.
     pub self_collision: bool,
+    /// The node serves MoveIt's planning-scene doors (`collision_object`, `planning_scene`, ...,
+    /// `apply_planning_scene`, `get_planning_scene`); read at start.
+    pub planning_scene: bool,
     /// Files named on the command line in place of the two above.
     #[serde(skip)]
     pub input_files: InputFiles,
@@ -200,6 +203,7 @@ impl Default for Params {
             clearance_threshold: 0.0,
             robot_semantic_file: String::new(),
             self_collision: true,
+            planning_scene: true,
             input_files: InputFiles::default(),
         }
     }

@@ -125,7 +125,7 @@ fn mesh(m: &crate::msgs::planning_scene::ShapeMesh, id: &str, k: usize) -> Resul
     if triangles.is_empty() {
         return Err(format!("collision object '{id}': meshes[{k}]: no triangles"));
     }
-    Ok(WorldShape::Mesh(MeshData { vertices, triangles }))
+    Ok(WorldShape::Mesh(std::sync::Arc::new(MeshData { vertices, triangles })))
 }
 
 #[cfg(test)]

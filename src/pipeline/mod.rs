@@ -8,15 +8,13 @@
 //! nothing that was not checked is ever reported, and a state that cannot be checked where an
 //! answer is owed (a service slot, a `check` line) fails closed (`in_collision` and `error`).
 
-mod joint_input;
-// A CollisionObject's geometry read for the planning world; not yet fed by a door.
-#[allow(dead_code)]
 mod collision_object;
+mod joint_input;
 mod link_transforms;
-// The planning scene's world objects (MoveIt's operations); not yet fed by a door.
-#[allow(dead_code)]
 mod planning_world;
 mod report_adapter;
+mod scene_input;
+mod scene_state;
 mod skip;
 mod state_line;
 mod state_pipeline;

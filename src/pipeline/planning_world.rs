@@ -135,6 +135,7 @@ impl<S> PlanningWorld<S> {
     }
 
     /// Every shape with its pose in the world, object by object in id order.
+    #[cfg(test)]
     pub fn shapes_in_world(&self) -> impl Iterator<Item = (&str, &S, Pose)> {
         self.objects.iter().flat_map(|(id, o)| o.shapes.iter().map(move |(s, p)| (id.as_str(), s, o.pose * *p)))
     }

@@ -27,11 +27,30 @@ pub enum SkipCause {
     Unreachable,
     /// A state overtaken by a newer one before the node could check it (the node only).
     Stale,
+    /// A planning-scene message whose `header.frame_id` (or a fixed frame's parent) is no known
+    /// frame, or names a robot link while the robot's state is unknown.
+    SceneFrame,
+    /// A planning-scene object with a field that cannot be used: non-finite vertices or poses,
+    /// out-of-range triangle indices, shape and pose arrays of different lengths, an unknown
+    /// shape type, wrong dimensions.
+    SceneGeometry,
+    /// A `REMOVE` or `MOVE` of an id the scene does not hold.
+    SceneUnknownId,
+    /// An object operation that is not ADD, REMOVE, APPEND or MOVE.
+    SceneOperation,
+    /// An object id that is empty, or names a link of the robot or the environment.
+    SceneId,
+    /// Past the scene's bounds: triangles per object or in all, objects.
+    SceneBounds,
+    /// A part of a planning-scene message not supported yet (the message is refused whole).
+    SceneUnsupported,
+    /// An octomap in a planning-scene message: refused (the rest of the message applies).
+    SceneOctomap,
 }
 
 impl SkipCause {
     /// Every cause, in the order reports list them.
-    pub const ALL: [SkipCause; 10] = [
+    pub const ALL: [SkipCause; 18] = [
         SkipCause::Undecodable,
         SkipCause::Lengths,
         SkipCause::NonFinite,
@@ -42,7 +61,20 @@ impl SkipCause {
         SkipCause::NotOurRobot,
         SkipCause::Unreachable,
         SkipCause::Stale,
+        SkipCause::SceneFrame,
+        SkipCause::SceneGeometry,
+        SkipCause::SceneUnknownId,
+        SkipCause::SceneOperation,
+        SkipCause::SceneId,
+        SkipCause::SceneBounds,
+        SkipCause::SceneUnsupported,
+        SkipCause::SceneOctomap,
     ];
+
+    /// A refused planning-scene message (not a state message).
+    pub fn is_scene(self) -> bool {
+        self.key().starts_with("scene_")
+    }
 
     /// The name used in `/diagnostics` keys, summaries and logs.
     pub fn key(self) -> &'static str {
@@ -57,6 +89,14 @@ impl SkipCause {
             SkipCause::NotOurRobot => "not_our_robot",
             SkipCause::Unreachable => "unreachable",
             SkipCause::Stale => "stale",
+            SkipCause::SceneFrame => "scene_frame",
+            SkipCause::SceneGeometry => "scene_geometry",
+            SkipCause::SceneUnknownId => "scene_unknown_id",
+            SkipCause::SceneOperation => "scene_operation",
+            SkipCause::SceneId => "scene_id",
+            SkipCause::SceneBounds => "scene_bounds",
+            SkipCause::SceneUnsupported => "scene_unsupported",
+            SkipCause::SceneOctomap => "scene_octomap",
         }
     }
 }

@@ -5,9 +5,10 @@
 
 use super::joint_input::JointInput;
 use super::report_adapter::CheckedState;
+use super::scene_state::SceneState;
 use super::skip::{Skip, SkipCause};
 use super::tf_tree::{TfRejection, TfTree};
-use crate::checker::{read_semantic_file, Checker, CheckerError, StateError, StateReport};
+use crate::checker::{read_semantic_file, BodyCache, Checker, CheckerError, StateError, StateReport};
 use crate::math::Pose;
 use crate::model::{MissingJoint, Params};
 use crate::msgs::{CollisionReport, JointState, TfMessage, Time};
@@ -65,13 +66,19 @@ enum StatePose {
 
 /// Messages in, checked states out. See the module documentation.
 pub struct Pipeline {
-    checker: Arc<Checker>,
+    pub(super) checker: Arc<Checker>,
     source: RobotSource,
     joints: JointInput,
     tf: TfTree,
     skipped: BTreeMap<SkipCause, u64>,
     unknown_names: HashSet<String>,
-    warnings: Vec<String>,
+    pub(super) warnings: Vec<String>,
+    /// The planning scene's objects and frames in force (in the checker's scene too).
+    pub(super) scene: SceneState,
+    /// The cells built for the planning scene's meshes, kept while the scene holds them.
+    pub(super) bodies: BodyCache,
+    /// An octomap was refused (it is warned about once).
+    pub(super) octomap_warned: bool,
     /// Stamp of the last state accepted, while the next one may follow it.
     last_stamp: Option<Time>,
     /// The last state checked or covered by a report: where the next motion starts.
@@ -103,6 +110,9 @@ impl Pipeline {
             skipped: BTreeMap::new(),
             unknown_names: HashSet::new(),
             warnings: Vec::new(),
+            scene: SceneState::default(),
+            bodies: BodyCache::default(),
+            octomap_warned: false,
             last_stamp: None,
             trail: None,
             semantic: None,
@@ -454,7 +464,28 @@ impl Pipeline {
         }
     }
 
+    /// A new robot, environment or parameters: the planning scene's objects are put beside the
+    /// environment again (an object that cannot be, say with an id that is now a robot link's,
+    /// drops the scene's objects, warned).
     fn replace(&mut self, checker: Checker) {
+        let checker = if self.scene.is_empty() {
+            checker
+        } else {
+            let objects = self.scene.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
+            match checker.with_world(objects, &mut self.bodies) {
+                Ok(with) => with,
+                Err(e) => {
+                    self.warnings.push(format!("the planning scene's {} objects are dropped: {e}", self.scene.world.len()));
+                    self.scene = SceneState::default();
+                    checker
+                }
+            }
+        };
+        self.swap(checker);
+    }
+
+    /// Puts `checker` in force.
+    pub(super) fn swap(&mut self, checker: Checker) {
         let same_joints = checker.robot().joints.iter().map(|j| &j.name).eq(self.checker.robot().joints.iter().map(|j| &j.name));
         if !same_joints {
             self.joints = JointInput::new(&checker);

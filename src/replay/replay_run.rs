@@ -296,6 +296,12 @@ impl<'a> Replayer<'a> {
             apply_semantic(pipeline, m, &opts.bag, &mut self.summary, warnings);
             return None;
         }
+        if let Some(result) = apply_scene_message(pipeline, m, warnings) {
+            if let Err(Skip { cause, message }) = result {
+                warnings.warn(cause.key(), || format!("{} at log time {} ns refused ({}): {message}", m.topic, m.log_time, cause.key()));
+            }
+            return None;
+        }
         if self.pose_source == PoseSource::Tf && m.topic == "/tf_static" {
             return decode::<TfMessage>(pipeline, m, warnings).map(|msg| pipeline.tf_static(&msg).map(|()| None));
         }
@@ -385,6 +391,24 @@ fn decode<T: serde::de::DeserializeOwned>(pipeline: &mut Pipeline, m: &BagMessag
             None
         }
     }
+}
+
+/// A planning-scene message (MoveIt's topics in the root namespace, as the node subscribes them
+/// there), applied at its log time as the node applies it on arrival: `None` for another topic,
+/// else whether it was applied (an undecodable one is counted and warned about, and `Ok`).
+fn apply_scene_message(pipeline: &mut Pipeline, m: &BagMessage, warnings: &mut FirstWarnings) -> Option<Result<(), Skip>> {
+    use crate::msgs::planning_scene::{AttachedCollisionObject, CollisionObject, PlanningScene, PlanningSceneWorld};
+    let result = match m.topic.as_str() {
+        "/collision_object" => decode::<CollisionObject>(pipeline, m, warnings).map(|o| pipeline.collision_object(&o)),
+        "/attached_collision_object" => decode::<AttachedCollisionObject>(pipeline, m, warnings).map(|o| pipeline.attached_collision_object(&o)),
+        "/planning_scene" => decode::<PlanningScene>(pipeline, m, warnings).map(|s| pipeline.planning_scene(&s)),
+        "/planning_scene_world" => decode::<PlanningSceneWorld>(pipeline, m, warnings).map(|w| pipeline.planning_scene_world(&w)),
+        _ => return None,
+    };
+    for w in pipeline.take_warnings() {
+        warnings.observer.warning(&w);
+    }
+    Some(result.unwrap_or(Ok(())))
 }
 
 fn apply_description(pipeline: &mut Pipeline, m: &BagMessage, bag: &Path, summary: &mut ReplaySummary, warnings: &mut FirstWarnings) {

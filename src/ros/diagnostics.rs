@@ -57,7 +57,8 @@ pub(crate) fn diagnostics(
 ) -> DiagnosticArray {
     let rate = (stats.received - stats.last_received) as f64 / seconds.max(1e-9);
     let mean = if stats.window_checks > 0 { stats.check_sum / stats.window_checks as f64 } else { 0.0 };
-    let total: u64 = skipped.values().sum();
+    let total: u64 = skipped.iter().filter(|(c, _)| !c.is_scene()).map(|(_, n)| n).sum();
+    let scene_refused: u64 = skipped.iter().filter(|(c, _)| c.is_scene()).map(|(_, n)| n).sum();
     let bad: u64 = skipped.iter().filter(|(c, _)| **c != SkipCause::Stale).map(|(_, n)| n).sum();
     let kv = |k: &str, v: String| KeyValue { key: k.into(), value: v };
     let mut values = vec![
@@ -72,9 +73,10 @@ pub(crate) fn diagnostics(
     for cause in SkipCause::ALL {
         values.push(kv(&format!("skipped_{}", cause.key()), skipped.get(&cause).copied().unwrap_or(0).to_string()));
     }
+    values.push(kv("scene_refused", scene_refused.to_string()));
     values.push(kv("robot_description_error", description_error.unwrap_or_default().to_owned()));
     values.push(kv("check_state_validity_refused", stats.validity_refused.to_string()));
-    let counts = format!("{rate:.1} states/s, {total} skipped ({bad} bad or foreign)");
+    let counts = format!("{rate:.1} states/s, {total} skipped, {scene_refused} scene messages refused ({bad} bad or foreign in all)");
     let (level, message) = match description_error {
         Some(e) => (ERROR, e.to_owned()),
         None => (if bad > 0 { WARN } else { OK }, counts),

@@ -8,6 +8,10 @@ use super::param_services::{ros_mapping, ParamRequest};
 use super::ros_args::RosArgs;
 use crate::model::{Params, PoseSource};
 use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
+use crate::msgs::planning_scene::{
+    ApplyPlanningSceneRequest, ApplyPlanningSceneResponse, AttachedCollisionObject, CollisionObject, GetPlanningSceneRequest, GetPlanningSceneResponse,
+    PlanningScene, PlanningSceneWorld,
+};
 use crate::msgs::{CheckStatesRequest, CheckStatesResponse, ClockMsg};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, CollisionReport, DiagnosticArray, JointState, MarkerArray, TfMessage, Time};
 use anyhow::{anyhow, Result};
@@ -43,6 +47,13 @@ pub(super) enum Event {
     ValidityRequest(RmwRequestId, Box<GetStateValidityRequest>),
     /// The worker checked a state: the answer to send, and why the request was not honoured.
     ValidityDone(RmwRequestId, GetStateValidityResponse, Option<String>),
+    /// Planning-scene inputs (boxed: a scene message is large, and rare).
+    CollisionObject(Box<CollisionObject>),
+    AttachedObject(Box<AttachedCollisionObject>),
+    Scene(Box<PlanningScene>),
+    SceneWorld(Box<PlanningSceneWorld>),
+    ApplyScene(RmwRequestId, Box<ApplyPlanningSceneRequest>),
+    GetScene(RmwRequestId, GetPlanningSceneRequest),
     /// A parameter service request (served here with the basic and cyclone mappings).
     Parameter(ParamRequest),
     /// A sample that could not be read (on the topic or service named).
@@ -67,7 +78,53 @@ pub(super) struct Interfaces {
     pub(super) check_states: Server<CheckStatesRequest, CheckStatesResponse>,
     pub(super) check_trajectory: Server<CheckTrajectoryRequest, CheckTrajectoryResponse>,
     pub(super) check_state_validity: Server<GetStateValidityRequest, GetStateValidityResponse>,
+    /// MoveIt's planning-scene doors, with the parameter `planning_scene`.
+    pub(super) scene: Option<SceneDoors>,
     pub(super) names: Names,
+}
+
+/// The subscriptions and services of MoveIt's planning scene (`planning_scene_monitor`'s and
+/// `move_group`'s names, relative to the node).
+pub(super) struct SceneDoors {
+    objects: Subscription<CollisionObject>,
+    attached: Subscription<AttachedCollisionObject>,
+    scenes: Subscription<PlanningScene>,
+    worlds: Subscription<PlanningSceneWorld>,
+    pub(super) apply: Server<ApplyPlanningSceneRequest, ApplyPlanningSceneResponse>,
+    pub(super) get: Server<GetPlanningSceneRequest, GetPlanningSceneResponse>,
+}
+
+impl SceneDoors {
+    /// Reliable, volatile, keep last 10 (MoveIt's `ServicesQoS`, which its scene topics use).
+    fn build(node: &mut Node, names: &Names, ns: &str, mapping: ServiceMapping) -> Result<SceneDoors> {
+        let qos = reliable(10);
+        let mut sub = |name: &str, ty: &'static str| topic(node, name, ns, ("moveit_msgs", ty), &qos);
+        let (o, a, s, w) = (
+            sub(&names.collision_object, "CollisionObject")?,
+            sub(&names.attached_collision_object, "AttachedCollisionObject")?,
+            sub(&names.planning_scene, "PlanningScene")?,
+            sub(&names.planning_scene_world, "PlanningSceneWorld")?,
+        );
+        Ok(SceneDoors {
+            objects: subscription(node, &o, Some(qos.clone()), &names.collision_object)?,
+            attached: subscription(node, &a, Some(qos.clone()), &names.attached_collision_object)?,
+            scenes: subscription(node, &s, Some(qos.clone()), &names.planning_scene)?,
+            worlds: subscription(node, &w, Some(qos.clone()), &names.planning_scene_world)?,
+            apply: server(node, mapping, &names.apply_planning_scene, ns, ("moveit_msgs", "ApplyPlanningScene"))?,
+            get: server(node, mapping, &names.get_planning_scene, ns, ("moveit_msgs", "GetPlanningScene"))?,
+        })
+    }
+
+    fn events(&self) -> Vec<Events<'_>> {
+        vec![
+            read(&self.objects, "collision_object", |m| Event::CollisionObject(Box::new(m))),
+            read(&self.attached, "attached_collision_object", |m| Event::AttachedObject(Box::new(m))),
+            read(&self.scenes, "planning_scene", |m| Event::Scene(Box::new(m))),
+            read(&self.worlds, "planning_scene_world", |m| Event::SceneWorld(Box::new(m))),
+            requests(&self.apply, "apply_planning_scene", |id, q| Event::ApplyScene(id, Box::new(q))),
+            requests(&self.get, "get_planning_scene", Event::GetScene),
+        ]
+    }
 }
 
 /// Resolved names, for the banner and the warnings.
@@ -81,6 +138,12 @@ pub(super) struct Names {
     pub(super) semantic: String,
     pub(super) cells: String,
     pub(super) contacts: String,
+    pub(super) collision_object: String,
+    pub(super) attached_collision_object: String,
+    pub(super) planning_scene: String,
+    pub(super) planning_scene_world: String,
+    pub(super) apply_planning_scene: String,
+    pub(super) get_planning_scene: String,
 }
 
 impl Names {
@@ -95,6 +158,12 @@ impl Names {
             semantic: resolve(remaps, "robot_description_semantic"),
             cells: resolve(remaps, "collision_markers/cells"),
             contacts: resolve(remaps, "collision_markers/contacts"),
+            collision_object: resolve(remaps, "collision_object"),
+            attached_collision_object: resolve(remaps, "attached_collision_object"),
+            planning_scene: resolve(remaps, "planning_scene"),
+            planning_scene_world: resolve(remaps, "planning_scene_world"),
+            apply_planning_scene: resolve(remaps, "apply_planning_scene"),
+            get_planning_scene: resolve(remaps, "get_planning_scene"),
         }
     }
 }
@@ -221,6 +290,8 @@ impl Interfaces {
             // MoveIt's service type, so a planner calls it unchanged (remap to /check_state_validity
             // to take move_group's name; never with move_group serving it too).
             check_state_validity: server(node, mapping, &names.check_state_validity, ns, ("moveit_msgs", "GetStateValidity"))?,
+            // move_group's names in the root namespace: never run both on one name (`-r` remaps).
+            scene: if params.planning_scene { Some(SceneDoors::build(node, &names, ns, mapping)?) } else { None },
             names,
         })
     }
@@ -241,6 +312,9 @@ impl Interfaces {
         sources.push(requests(&self.check_states, "check_states", Event::Request));
         sources.push(requests(&self.check_trajectory, "check_trajectory", Event::TrajectoryRequest));
         sources.push(requests(&self.check_state_validity, "check_state_validity", |id, q| Event::ValidityRequest(id, Box::new(q))));
+        if let Some(scene) = &self.scene {
+            sources.extend(scene.events());
+        }
         sources
     }
 }

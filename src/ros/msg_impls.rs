@@ -4,6 +4,10 @@
 
 use super::description_msg::DescriptionMsg;
 use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
+use crate::msgs::planning_scene::{
+    ApplyPlanningSceneRequest, ApplyPlanningSceneResponse, AttachedCollisionObject, CollisionObject, GetPlanningSceneRequest, GetPlanningSceneResponse,
+    PlanningScene, PlanningSceneWorld,
+};
 use crate::msgs::{
     CheckStatesRequest, CheckStatesResponse, CheckTrajectoryRequest, CheckTrajectoryResponse, ClockMsg, CollisionReport, DiagnosticArray, JointState,
     MarkerArray, StringMsg, TfMessage,
@@ -23,3 +27,11 @@ impl ros2_client::Message for ClockMsg {}
 impl ros2_client::Message for GetStateValidityRequest {}
 impl ros2_client::Message for GetStateValidityResponse {}
 impl ros2_client::Message for DescriptionMsg {}
+impl ros2_client::Message for CollisionObject {}
+impl ros2_client::Message for AttachedCollisionObject {}
+impl ros2_client::Message for PlanningScene {}
+impl ros2_client::Message for PlanningSceneWorld {}
+impl ros2_client::Message for ApplyPlanningSceneRequest {}
+impl ros2_client::Message for ApplyPlanningSceneResponse {}
+impl ros2_client::Message for GetPlanningSceneRequest {}
+impl ros2_client::Message for GetPlanningSceneResponse {}

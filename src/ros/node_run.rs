@@ -137,6 +137,13 @@ fn print_banner(pipeline: &Pipeline, node: &Node, io: &Interfaces, domain: u16, 
         "  subscribes {input}, publishes {} (thickness_collision_msgs/msg/CollisionReport), serves {}, {} and {} (moveit_msgs/srv/GetStateValidity)",
         io.names.collisions, io.names.check_states, io.names.check_trajectory, io.names.check_state_validity
     );
+    if io.scene.is_some() {
+        let n = &io.names;
+        println!(
+            "  planning scene: subscribes {}, {}, {}, {} (moveit_msgs), serves {} and {}",
+            n.collision_object, n.attached_collision_object, n.planning_scene, n.planning_scene_world, n.apply_planning_scene, n.get_planning_scene
+        );
+    }
 }
 
 /// Runs the node until Ctrl-C or SIGTERM.

@@ -13,6 +13,7 @@ use crate::limits::MAX_DESCRIPTION_BYTES;
 use crate::markers::{cell_markers, contact_markers};
 use crate::model::Params;
 use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
+use crate::msgs::planning_scene::{ApplyPlanningSceneRequest, ApplyPlanningSceneResponse, GetPlanningSceneRequest, GetPlanningSceneResponse};
 use crate::msgs::{CheckStatesRequest, CheckStatesResponse};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, JointState, TfMessage, Time};
 use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause};
@@ -88,6 +89,20 @@ impl NodeState {
             Event::TrajectoryDone(id, answer) => self.send_trajectory_answer(io, id, answer),
             Event::ValidityRequest(id, req) => self.on_validity_request(io, workers, id, req),
             Event::ValidityDone(id, answer, reason) => self.send_validity_answer(io, id, answer, reason),
+            Event::CollisionObject(m) => {
+                let _ = self.on_scene_input(io, |p| p.collision_object(&m));
+            }
+            Event::AttachedObject(m) => {
+                let _ = self.on_scene_input(io, |p| p.attached_collision_object(&m));
+            }
+            Event::Scene(m) => {
+                let _ = self.on_scene_input(io, |p| p.planning_scene(&m));
+            }
+            Event::SceneWorld(m) => {
+                let _ = self.on_scene_input(io, |p| p.planning_scene_world(&m));
+            }
+            Event::ApplyScene(id, req) => self.on_apply_scene(io, id, &req),
+            Event::GetScene(id, req) => self.on_get_scene(io, id, req),
             Event::ReadFailed(what, e) => self.on_read_failed(what, &e),
             Event::States | Event::Parameter(_) | Event::Tick => {}
         }
@@ -300,6 +315,44 @@ impl NodeState {
                 self.description_error = None;
             }
             Err(refused) => self.refuse_text(&io.names.semantic, "keeping the current collision matrix", refused),
+        }
+    }
+
+    /// A planning-scene message, applied by the pipeline before the next input is handled; a
+    /// refused one is warned about and counted, the scene in force unchanged. True when applied.
+    fn on_scene_input(&mut self, io: &Interfaces, apply: impl FnOnce(&mut Pipeline) -> Result<(), Skip>) -> bool {
+        // Building a large object's cells may take a while: a forced stop meanwhile tells the counts.
+        self.refresh_summary();
+        let result = apply(&mut self.pipeline);
+        self.warn_pending();
+        match result {
+            Ok(()) => {
+                self.publish_cells(io);
+                true
+            }
+            Err(skip) => {
+                self.warn_skip(&skip);
+                false
+            }
+        }
+    }
+
+    /// `apply_planning_scene`: `success` once the scene is in force (every state handled after
+    /// the reply is checked against it), false when it was refused (the scene unchanged).
+    fn on_apply_scene(&mut self, io: &Interfaces, id: RmwRequestId, req: &ApplyPlanningSceneRequest) {
+        let success = self.on_scene_input(io, |p| p.planning_scene(&req.scene));
+        let Some(doors) = &io.scene else { return };
+        if doors.apply.send_response(id, ApplyPlanningSceneResponse { success }).is_err() {
+            self.on_send_failed(&io.names.apply_planning_scene);
+        }
+    }
+
+    /// `get_planning_scene`: the scene in force, the components asked for.
+    fn on_get_scene(&mut self, io: &Interfaces, id: RmwRequestId, req: GetPlanningSceneRequest) {
+        let scene = self.pipeline.planning_scene_message(req.components.components, self.now());
+        let Some(doors) = &io.scene else { return };
+        if doors.get.send_response(id, GetPlanningSceneResponse { scene }).is_err() {
+            self.on_send_failed(&io.names.get_planning_scene);
         }
     }
 

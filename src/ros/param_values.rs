@@ -7,7 +7,7 @@ use serde_json::Value;
 use std::sync::{Arc, Mutex};
 
 /// Parameters that shape the node's topics and services, fixed once they are created.
-pub(crate) const READ_ONLY: [&str; 3] = ["pose_source", "service_mapping", "use_sim_time"];
+pub(crate) const READ_ONLY: [&str; 4] = ["planning_scene", "pose_source", "service_mapping", "use_sim_time"];
 
 /// Every parameter with its ROS 2 value. An empty list takes its element type from
 /// [`Params::array_kinds`] (JSON cannot tell an empty list of numbers from one of strings).

@@ -1,0 +1,101 @@
+//! The pipeline's planning-scene doors: the messages of MoveIt's `planning_scene_monitor`
+//! (`collision_object`, `attached_collision_object`, `planning_scene`, `planning_scene_world`,
+//! and the `apply_planning_scene` request) applied to the scene in force, and the scene as
+//! `get_planning_scene` gives it. A change is in force when the call returns: every state checked
+//! after it sees the new scene. A refusal is counted by cause and leaves the scene unchanged.
+
+use super::scene_state::{FrameContext, SceneState};
+use super::skip::{Skip, SkipCause};
+use super::state_pipeline::Pipeline;
+use crate::math::{pose_from_isometry, Pose};
+use crate::msgs::planning_scene::{AttachedCollisionObject, CollisionObject, OctomapWithPose, PlanningScene, PlanningSceneWorld};
+use crate::msgs::Time;
+
+impl Pipeline {
+    /// A `moveit_msgs/CollisionObject` (the `collision_object` topic).
+    pub(crate) fn collision_object(&mut self, msg: &CollisionObject) -> Result<(), Skip> {
+        self.change_scene(|s, ctx| s.apply_object(ctx, msg))
+    }
+
+    /// A `moveit_msgs/PlanningSceneWorld` (the `planning_scene_world` topic): its objects replace
+    /// the world's.
+    pub(crate) fn planning_scene_world(&mut self, msg: &PlanningSceneWorld) -> Result<(), Skip> {
+        self.refuse_octomap(&msg.octomap);
+        self.change_scene(|s, ctx| s.apply_world(ctx, msg))
+    }
+
+    /// A `moveit_msgs/PlanningScene` (the `planning_scene` topic, the `apply_planning_scene`
+    /// request): a difference, or the whole scene when `is_diff` is false.
+    pub(crate) fn planning_scene(&mut self, msg: &PlanningScene) -> Result<(), Skip> {
+        self.refuse_octomap(&msg.world.octomap);
+        self.change_scene(|s, ctx| s.apply_scene(ctx, msg))
+    }
+
+    /// A `moveit_msgs/AttachedCollisionObject`: not supported yet, refused and counted (the
+    /// object is not checked: the log says so).
+    pub(crate) fn attached_collision_object(&mut self, msg: &AttachedCollisionObject) -> Result<(), Skip> {
+        let skip = Skip {
+            cause: SkipCause::SceneUnsupported,
+            message: format!("attached collision object '{}' on link '{}': attached objects are not supported yet; not checked", msg.object.id, msg.link_name),
+        };
+        self.count_skip(skip.cause, 1);
+        Err(skip)
+    }
+
+    /// The scene in force as `get_planning_scene` answers (`components` as in
+    /// `moveit_msgs/PlanningSceneComponents`), stamped `stamp`.
+    pub(crate) fn planning_scene_message(&self, components: u32, stamp: Time) -> PlanningScene {
+        self.scene.message(&self.checker, components, stamp)
+    }
+
+    /// Planning-scene objects in force.
+    pub fn scene_object_count(&self) -> usize {
+        self.scene.world.len()
+    }
+
+    /// An octomap (non-empty data) cannot be checked: refused with a warning the first time, and
+    /// counted each time.
+    fn refuse_octomap(&mut self, octomap: &OctomapWithPose) {
+        if octomap.octomap.data.is_empty() {
+            return;
+        }
+        self.count_skip(SkipCause::SceneOctomap, 1);
+        if !self.octomap_warned {
+            self.octomap_warned = true;
+            self.warnings
+                .push("planning scene: an octomap is not supported: refused, the rest of the message applies (warned once, counted as scene_octomap)".into());
+        }
+    }
+
+    /// Applies `change` to a copy of the scene in force and, when it succeeds and the checker of
+    /// the new scene is built, puts both in force.
+    fn change_scene(&mut self, change: impl FnOnce(&mut SceneState, &FrameContext) -> Result<(), Skip>) -> Result<(), Skip> {
+        let mut next = self.scene.clone();
+        let robot_links = || self.robot_link_poses();
+        let result = change(&mut next, &FrameContext { checker: &self.checker, robot_links: &robot_links }).and_then(|()| {
+            let objects = next.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
+            self.checker.with_world(objects, &mut self.bodies).map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() })
+        });
+        match result {
+            Ok(checker) => {
+                self.scene = next;
+                self.swap(checker);
+                Ok(())
+            }
+            Err(skip) => {
+                self.count_skip(skip.cause, 1);
+                Err(skip)
+            }
+        }
+    }
+
+    /// The robot's link poses in the world at the merged joint state (a joint never received
+    /// as the `missing_joint` rule has it), as MoveIt places an object given in a robot link's
+    /// frame at its current state.
+    fn robot_link_poses(&self) -> Result<Vec<Pose>, String> {
+        let robot = self.checker.robot();
+        let q = (0..robot.joints.len()).map(|j| self.left_out_position(j, "the message")).collect::<Result<Vec<f64>, String>>()?;
+        let poses = robot.forward_kinematics(&q, self.checker.base_pose()).map_err(|e| e.to_string())?;
+        Ok(poses.iter().map(pose_from_isometry).collect())
+    }
+}
