@@ -36,3 +36,5 @@ pub(crate) use self::validity::ValidityJob;
 
 #[cfg(test)]
 mod pipeline_tests;
+#[cfg(test)]
+mod scene_tests;

@@ -129,6 +129,14 @@ fn print_banner(pipeline: &Pipeline, node: &Node, io: &Interfaces, domain: u16, 
         s.build_seconds * 1e3
     );
     println!("  {}", pipeline.checker().self_pairs().summary(pipeline.checker()));
+    // Before the line that ends the banner (the one that says what it serves).
+    if io.scene.is_some() {
+        let n = &io.names;
+        println!(
+            "  planning scene: subscribes {}, {}, {}, {} (moveit_msgs), answers {} and {}",
+            n.collision_object, n.attached_collision_object, n.planning_scene, n.planning_scene_world, n.apply_planning_scene, n.get_planning_scene
+        );
+    }
     let input = match p.pose_source {
         PoseSource::Tf => format!("/tf and /tf_static (tf2_msgs/msg/TFMessage, frame prefix '{}')", p.frame_prefix),
         PoseSource::JointStates => format!("{} (sensor_msgs/msg/JointState)", io.names.joint_states),
@@ -137,13 +145,6 @@ fn print_banner(pipeline: &Pipeline, node: &Node, io: &Interfaces, domain: u16, 
         "  subscribes {input}, publishes {} (thickness_collision_msgs/msg/CollisionReport), serves {}, {} and {} (moveit_msgs/srv/GetStateValidity)",
         io.names.collisions, io.names.check_states, io.names.check_trajectory, io.names.check_state_validity
     );
-    if io.scene.is_some() {
-        let n = &io.names;
-        println!(
-            "  planning scene: subscribes {}, {}, {}, {} (moveit_msgs), serves {} and {}",
-            n.collision_object, n.attached_collision_object, n.planning_scene, n.planning_scene_world, n.apply_planning_scene, n.get_planning_scene
-        );
-    }
 }
 
 /// Runs the node until Ctrl-C or SIGTERM.

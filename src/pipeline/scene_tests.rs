@@ -1,0 +1,174 @@
+//! The planning scene on the pipeline, without DDS: cells built once per geometry, frames
+//! resolved as MoveIt resolves them, whole-or-nothing messages, the scene kept across a new robot
+//! description, and `get_planning_scene`'s answer applied again giving the same world.
+
+use super::{Pipeline, SkipCause};
+use crate::math::{pose_from_isometry, Pose, Vector};
+use crate::mesh::generate;
+use crate::model::Params;
+use crate::msgs::planning_scene::{CollisionObject, MeshTriangle, PlanningScene, PlanningSceneComponents, ShapeMesh, SolidPrimitive};
+use crate::msgs::{Header, JointState, Point, PoseMsg, Quaternion, Time};
+
+const ARM: [&str; 7] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
+
+fn at(x: f64, y: f64, z: f64) -> PoseMsg {
+    PoseMsg { position: Point { x, y, z }, orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 } }
+}
+
+fn sheet() -> ShapeMesh {
+    let (v, t) = generate::flat_grid(10, 10, 0.6, 0.6);
+    ShapeMesh {
+        vertices: v.iter().map(|p| Point { x: p.x, y: p.y, z: p.z }).collect(),
+        triangles: t.iter().map(|t| MeshTriangle { vertex_indices: *t }).collect(),
+    }
+}
+
+fn object(frame: &str, id: &str, operation: u8) -> CollisionObject {
+    CollisionObject {
+        header: Header { stamp: Time::default(), frame_id: frame.into() },
+        id: id.into(),
+        operation,
+        pose: at(0.0, 0.0, 0.0),
+        ..Default::default()
+    }
+}
+
+fn sheet_at(x: f64, y: f64, z: f64) -> CollisionObject {
+    CollisionObject { pose: at(x, y, z), meshes: vec![sheet()], ..object("world", "scan", CollisionObject::ADD) }
+}
+
+/// Random states of the bundled arm, and the pipeline's reports for them.
+fn reports(p: &Pipeline) -> Vec<(bool, Vec<(String, String)>)> {
+    let names: Vec<String> = ARM.iter().map(|s| s.to_string()).collect();
+    let mut rng = oorandom::Rand64::new(5);
+    (0..150)
+        .map(|_| {
+            let q: Vec<f64> = ARM.iter().map(|_| -2.0 + 4.0 * rng.rand_float()).collect();
+            let r = p.checker().check_joints(&names, &q).unwrap();
+            (r.in_collision, r.contacts.into_iter().map(|c| (c.link_name, c.object_name)).collect())
+        })
+        .collect()
+}
+
+/// A MOVE, and `move_group`'s full re-ADD of the same geometry at a new pose, build no cells:
+/// the world is the one a fresh pipeline builds with the object added there.
+#[test]
+fn moving_and_re_adding_an_object_reuses_its_cells() {
+    let mut p = Pipeline::new(Params::default()).unwrap();
+    p.collision_object(&sheet_at(0.2, -0.3, 0.3)).unwrap();
+    assert_eq!(p.bodies.built, 1);
+    let mv = CollisionObject { pose: at(0.1, -0.2, 0.4), ..object("world", "scan", CollisionObject::MOVE) };
+    p.collision_object(&mv).unwrap();
+    p.collision_object(&sheet_at(0.0, -0.25, 0.35)).unwrap();
+    assert_eq!(p.bodies.built, 1, "neither the move nor the re-ADD built cells");
+    let mut fresh = Pipeline::new(Params::default()).unwrap();
+    fresh.collision_object(&sheet_at(0.0, -0.25, 0.35)).unwrap();
+    let (a, b) = (reports(&p), reports(&fresh));
+    assert_eq!(a, b);
+    assert!(a.iter().filter(|(_, c)| c.iter().any(|(_, o)| o == "scan")).count() > 5, "the states must reach the sheet");
+    // A different thickness is another body.
+    let mut thick = Params::default();
+    thick.default_thickness = 0.05;
+    p.set_params(thick).unwrap();
+    assert_eq!(p.bodies.built, 2, "new parameters rebuild the object's cells");
+    assert_eq!(p.scene_object_count(), 1, "and keep the object");
+}
+
+/// Frames: an environment link, an object and its subframe, a fixed frame, a robot link at the
+/// merged state (refused while that state is unknown); anything else refused, counted.
+#[test]
+fn frames_resolve_as_moveit_resolves_them() {
+    let mut p = Pipeline::new(Params::default()).unwrap();
+    let ball = |frame: &str, id: &str| CollisionObject {
+        pose: at(0.0, 0.0, 0.1),
+        primitives: vec![SolidPrimitive { kind: SolidPrimitive::SPHERE, dimensions: vec![0.05], ..Default::default() }],
+        ..object(frame, id, CollisionObject::ADD)
+    };
+    let skip = p.collision_object(&ball("tool0", "held")).unwrap_err();
+    assert_eq!(skip.cause, SkipCause::SceneFrame);
+    assert!(skip.message.contains("is a robot link, but joint"), "{}", skip.message);
+    let q = [0.3, -1.0, 1.2, 0.1, 0.5, 0.2, 0.01];
+    let _ = p.joint_state(&JointState { name: ARM.iter().map(|s| s.to_string()).collect(), position: q.to_vec(), ..Default::default() }).unwrap();
+    p.collision_object(&ball("tool0", "held")).unwrap();
+    let robot = p.checker().robot();
+    let mut all = vec![0.0; robot.joints.len()];
+    for (name, v) in ARM.iter().zip(q) {
+        all[robot.joint(name).unwrap()] = v;
+    }
+    let links = robot.forward_kinematics(&all, p.checker().base_pose()).unwrap();
+    let tool = pose_from_isometry(&links[robot.link("tool0").unwrap()]);
+    let want = tool * Pose::from_translation(Vector::new(0.0, 0.0, 0.1));
+    let got = p.scene.world.get("held").unwrap().pose;
+    assert!((got.translation - want.translation).length() < 1e-12, "{got:?} vs {want:?}");
+    // An object with a subframe, and one placed at that subframe.
+    let mut with_sub = ball("world", "plate");
+    with_sub.pose = at(0.5, 0.0, 0.0);
+    with_sub.subframe_names = vec!["corner".into()];
+    with_sub.subframe_poses = vec![at(0.0, 0.1, 0.0)];
+    p.collision_object(&with_sub).unwrap();
+    p.collision_object(&ball("plate/corner", "on_corner")).unwrap();
+    assert!((p.scene.world.get("on_corner").unwrap().pose.translation - Vector::new(0.5, 0.1, 0.1)).length() < 1e-12);
+    p.collision_object(&ball("shelf", "on_shelf")).unwrap();
+    // A fixed frame from a scene difference.
+    let mut diff = PlanningScene { is_diff: true, ..Default::default() };
+    diff.fixed_frame_transforms.push(crate::msgs::TransformStamped {
+        header: Header { stamp: Time::default(), frame_id: "world".into() },
+        child_frame_id: "camera".into(),
+        transform: crate::msgs::Transform {
+            translation: crate::msgs::Vector3 { x: 1.0, y: 2.0, z: 3.0 },
+            rotation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 },
+        },
+    });
+    diff.world.collision_objects.push(ball("camera", "seen"));
+    p.planning_scene(&diff).unwrap();
+    assert!((p.scene.world.get("seen").unwrap().pose.translation - Vector::new(1.0, 2.0, 3.1)).length() < 1e-12);
+    let before = p.scene_object_count();
+    let skip = p.collision_object(&ball("nowhere", "x")).unwrap_err();
+    assert_eq!((skip.cause, p.scene_object_count()), (SkipCause::SceneFrame, before));
+    assert_eq!(p.skipped().get(&SkipCause::SceneFrame), Some(&2));
+}
+
+/// A message is applied whole or not at all; `is_diff = false` replaces the scene; a new robot
+/// description keeps it; `get_planning_scene`'s answer, applied to a fresh pipeline, gives the
+/// same world.
+#[test]
+fn scenes_apply_whole_and_travel_back() {
+    let mut p = Pipeline::new(Params::default()).unwrap();
+    p.collision_object(&sheet_at(0.2, -0.3, 0.3)).unwrap();
+    let crate_box = CollisionObject {
+        primitives: vec![SolidPrimitive { kind: SolidPrimitive::BOX, dimensions: vec![0.3, 0.2, 0.1], ..Default::default() }],
+        primitive_poses: vec![at(0.3, 0.1, 0.2)],
+        ..object("world", "crate", CollisionObject::ADD)
+    };
+    // The second object is bad: neither is applied.
+    let mut bad = crate_box.clone();
+    bad.id = "base_link".into();
+    let half = PlanningScene {
+        is_diff: true,
+        world: crate::msgs::planning_scene::PlanningSceneWorld { collision_objects: vec![crate_box.clone(), bad], ..Default::default() },
+        ..Default::default()
+    };
+    assert_eq!(p.planning_scene(&half).unwrap_err().cause, SkipCause::SceneId);
+    assert_eq!(p.scene_object_count(), 1);
+    p.collision_object(&crate_box).unwrap();
+    let all = PlanningSceneComponents::WORLD_OBJECT_GEOMETRY | PlanningSceneComponents::TRANSFORMS;
+    let msg = p.planning_scene_message(all, Time::default());
+    assert_eq!(msg.world.collision_objects.len(), 2);
+    let mut fresh = Pipeline::new(Params::default()).unwrap();
+    fresh.collision_object(&sheet_at(9.0, 9.0, 9.0)).unwrap();
+    fresh.planning_scene(&msg).unwrap();
+    assert_eq!(fresh.scene_object_count(), 2, "is_diff false replaced the fresh pipeline's scene");
+    assert_eq!(reports(&fresh), reports(&p));
+    // A new robot (the same URDF, as a description) keeps the world objects.
+    let urdf = std::fs::read_to_string(Params::default().robot_path()).unwrap().replace(
+        "filename=\"gripper.obj\"",
+        &format!("filename=\"file://{}\"", crate::model::bundled_config_dir().join("example_workcell/gripper.obj").display()),
+    );
+    let before = reports(&p);
+    p.set_robot_description(&urdf, "test").unwrap();
+    assert_eq!(p.scene_object_count(), 2);
+    assert_eq!(reports(&p), before);
+    // The names-only answer has ids and poses, no shapes.
+    let names = p.planning_scene_message(PlanningSceneComponents::WORLD_OBJECT_NAMES, Time::default());
+    assert!(names.world.collision_objects.iter().all(|o| o.primitives.is_empty() && o.meshes.is_empty()));
+}
