@@ -67,9 +67,7 @@ fn moving_and_re_adding_an_object_reuses_its_cells() {
     assert_eq!(a, b);
     assert!(a.iter().filter(|(_, c)| c.iter().any(|(_, o)| o == "scan")).count() > 5, "the states must reach the sheet");
     // A different thickness is another body.
-    let mut thick = Params::default();
-    thick.default_thickness = 0.05;
-    p.set_params(thick).unwrap();
+    p.set_params(Params { default_thickness: 0.05, ..Params::default() }).unwrap();
     assert_eq!(p.bodies.built, 2, "new parameters rebuild the object's cells");
     assert_eq!(p.scene_object_count(), 1, "and keep the object");
 }
