@@ -133,6 +133,7 @@ mod tests {
             normal: [0.0, 0.0, 1.0],
             triangle: 7,
             object_type: Default::default(),
+            link_type: crate::checker::ObjectType::RobotLink,
         };
         let report = StateReport { in_collision: true, contacts: vec![contact(0.01, 0.5), contact(0.2, -0.5)], ..Default::default() };
         let m = contact_markers(&report, "world", Time { sec: 3, nanosec: 4 }, DurationMsg::default()).markers;

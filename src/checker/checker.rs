@@ -53,6 +53,8 @@ pub struct Checker {
     /// `moving[j]`: joint `j` takes a position from joint states and moves a checked link (itself,
     /// or through a mimic). A state is complete when all of these are known.
     pub(super) moving: Vec<bool>,
+    /// The first targets are the robot's links; objects attached to them follow.
+    pub(super) robot_targets: usize,
     /// The scene's first objects are the environment's; planning-scene objects follow.
     pub(super) environment_objects: usize,
     /// The environment's links by name, with their poses in the world: frames a planning-scene
@@ -101,6 +103,15 @@ impl Checker {
     /// elsewhere (the pipeline's, for a robot that comes as a description).
     pub(crate) fn set_semantic_file_name(&mut self, file: String) {
         self.params.robot_semantic_file = file;
+    }
+
+    /// What target `ti` is: a robot link, or an object attached to one.
+    pub(crate) fn target_kind(&self, ti: usize) -> super::state_report::ObjectType {
+        if ti < self.robot_targets {
+            super::state_report::ObjectType::RobotLink
+        } else {
+            super::state_report::ObjectType::AttachedObject
+        }
     }
 
     /// The pose in the world of the environment's link `name`.

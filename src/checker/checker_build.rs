@@ -107,6 +107,7 @@ impl Checker {
         summary.build_seconds = started.elapsed().as_secs_f64();
         let base = base_isometry(&params.robot_base_pose);
         let scene_objects = scene.objects().len();
+        let robot_targets = targets.len();
         Ok(Checker {
             params,
             robot,
@@ -118,6 +119,7 @@ impl Checker {
             motion: OnceLock::new(),
             self_pairs: SelfPairs::default(),
             moving,
+            robot_targets,
             environment_objects: scene_objects,
             environment_frames: Arc::new(environment_frames),
         })
@@ -168,6 +170,7 @@ impl Checker {
             motion: self.motion.clone(),
             self_pairs,
             moving: self.moving.clone(),
+            robot_targets: self.robot_targets,
             environment_objects: self.environment_objects,
             environment_frames: Arc::clone(&self.environment_frames),
         }
@@ -331,7 +334,7 @@ fn no_checked_link(params: &Params, robot: &RobotModel, file: &str) -> CheckerEr
 
 /// Which joints move a checked link: the actuated joints on the path from each checked link to
 /// the root, a mimic standing for the joint it follows.
-fn moving_joints(robot: &RobotModel, targets: &[LinkTargets]) -> Vec<bool> {
+pub(super) fn moving_joints(robot: &RobotModel, targets: &[LinkTargets]) -> Vec<bool> {
     let mut moving = vec![false; robot.joints.len()];
     for t in targets {
         let mut link = t.link;

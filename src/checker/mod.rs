@@ -32,4 +32,5 @@ pub use self::link_targets::LinkTargets;
 pub use self::motion_sweep::MotionReport;
 pub use self::self_pairs::SelfPairs;
 pub use self::state_report::{ObjectType, ReportClearance, ReportContact, StateReport};
+pub(crate) use self::world_objects::Attached;
 pub(crate) use self::world_shapes::{BodyCache, WorldShape};

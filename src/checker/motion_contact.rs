@@ -77,6 +77,7 @@ impl Checker {
                     position: c.position.map(|p| p.to_array()),
                     normal: c.normal.to_array(),
                     object_type: ObjectType::Environment,
+                    link_type: self.target_kind(g.ti),
                 });
             }
         }
@@ -96,7 +97,8 @@ impl Checker {
                     depth: 0.0,
                     position: Some(c.position.to_array()),
                     normal: c.normal.to_array(),
-                    object_type: ObjectType::RobotLink,
+                    object_type: self.target_kind(b.ti),
+                    link_type: self.target_kind(a.ti),
                 });
             }
         }

@@ -10,7 +10,7 @@
 use super::checker::Checker;
 use super::link_targets::LinkTargets;
 use super::self_pairs::SelfPairs;
-use super::state_report::{ObjectType, ReportContact};
+use super::state_report::ReportContact;
 use crate::collision::{collide_pair, PairContact, Target};
 use crate::math::Pose;
 use crate::model::{RobotModel, Srdf};
@@ -164,7 +164,8 @@ impl Checker {
                     depth: c.depth,
                     position: Some(c.position.to_array()),
                     normal: c.normal.to_array(),
-                    object_type: ObjectType::RobotLink,
+                    object_type: self.target_kind(b),
+                    link_type: self.target_kind(a),
                 });
             }
         }

@@ -110,6 +110,7 @@ impl Checker {
                     position: c.position.map(|p| p.to_array()),
                     normal: c.normal.to_array(),
                     object_type: ObjectType::Environment,
+                    link_type: self.target_kind(ti),
                 });
             }
         }

@@ -17,9 +17,21 @@ pub struct ReportContact {
     pub position: Option<[f64; 3]>,
     /// Push-out direction (world frame).
     pub normal: [f64; 3],
-    /// What `object_name` is: an environment object, or (self-collision) another robot link.
+    /// What `object_name` is: an environment object, or (self-collision) another robot link or
+    /// an attached object.
     #[serde(default)]
     pub object_type: ObjectType,
+    /// What `link_name` is: a robot link, or an attached object (only then in JSON).
+    #[serde(default = "robot_link", skip_serializing_if = "is_robot_link")]
+    pub link_type: ObjectType,
+}
+
+fn robot_link() -> ObjectType {
+    ObjectType::RobotLink
+}
+
+fn is_robot_link(t: &ObjectType) -> bool {
+    *t == ObjectType::RobotLink
 }
 
 /// What a contact's object is, as `Contact.object_type`.
@@ -31,14 +43,17 @@ pub enum ObjectType {
     Environment,
     /// Another link of the robot: `link_name` is the pair's first link in model order.
     RobotLink,
+    /// An object attached to a robot link (a planning scene's attached collision object).
+    AttachedObject,
 }
 
 impl ObjectType {
-    /// `Contact.ENVIRONMENT` or `Contact.ROBOT_LINK`.
+    /// `Contact.ENVIRONMENT`, `Contact.ROBOT_LINK` or `Contact.ATTACHED_OBJECT`.
     pub fn code(self) -> u8 {
         match self {
             ObjectType::Environment => 0,
             ObjectType::RobotLink => 1,
+            ObjectType::AttachedObject => 2,
         }
     }
 }

@@ -1,12 +1,25 @@
 //! A checker with a planning scene's objects beside its environment.
 
 use super::checker::{BuildSummary, Checker};
-use super::checker_build::allowed_matrix;
+use super::checker_build::{allowed_matrix, moving_joints};
 use super::checker_error::CheckerError;
-use super::world_shapes::{add_world_object, BodyCache, WorldShape};
+use super::link_targets::LinkTargets;
+use super::world_shapes::{add_world_object, attached_part, BodyCache, WorldShape};
 use crate::collision::Scene;
 use crate::math::Pose;
+use crate::model::Params;
 use std::sync::Arc;
+
+/// An object attached to a robot link: checked as a collision element of a fixed child link of
+/// `link` named `id` would be, against the environment and the world objects, and against every
+/// robot link but `link` and `touch_links`.
+pub(crate) struct Attached<'a> {
+    pub id: &'a str,
+    pub link: &'a str,
+    /// Shapes with their poses in the link's frame.
+    pub shapes: &'a [(WorldShape, Pose)],
+    pub touch_links: &'a [String],
+}
 
 impl Checker {
     /// This checker with the planning scene's `objects` (id, pose in the world, shapes with their
@@ -15,9 +28,21 @@ impl Checker {
     /// `allowed_collisions`. An id that names an environment object or a robot link is refused,
     /// as is a shape that cannot be used. The build summary stays the environment's.
     /// Mesh bodies come from `cache` when it holds them (those no longer used are forgotten).
+    #[cfg(test)]
     pub(crate) fn with_world<'a>(
         &self,
         objects: impl IntoIterator<Item = (&'a str, &'a Pose, &'a [(WorldShape, Pose)])>,
+        cache: &mut BodyCache,
+    ) -> Result<Checker, CheckerError> {
+        self.with_scene(objects, &[], cache)
+    }
+
+    /// [`Checker::with_world`], with `attached` objects on the robot's links (those of an earlier
+    /// call replaced).
+    pub(crate) fn with_scene<'a>(
+        &self,
+        objects: impl IntoIterator<Item = (&'a str, &'a Pose, &'a [(WorldShape, Pose)])>,
+        attached: &[Attached],
         cache: &mut BodyCache,
     ) -> Result<Checker, CheckerError> {
         let environment = &self.scene.objects()[..self.environment_objects];
@@ -34,9 +59,75 @@ impl Checker {
         }
         cache.keep_used();
         let scene = self.scene.prefix_with(self.environment_objects, &added);
-        let allowed = allowed_matrix(&self.params, &self.targets, &scene);
-        Ok(self.rebuilt(Arc::new(scene), allowed, self.self_pairs.clone()))
+        self.with_targets(Arc::new(scene), attached)
     }
+
+    /// This checker with `attached` objects on the robot's links in place of its own (a
+    /// `check_state_validity` request's), the scene kept.
+    pub(crate) fn with_attached(&self, attached: &[Attached]) -> Result<Checker, CheckerError> {
+        self.with_targets(Arc::clone(&self.scene), attached)
+    }
+
+    fn with_targets(&self, scene: Arc<Scene>, attached: &[Attached]) -> Result<Checker, CheckerError> {
+        let mut targets = self.targets[..self.robot_targets].to_vec();
+        for a in attached {
+            targets.extend(self.attached_target(a)?);
+        }
+        let allowed = allowed_matrix(&self.params, &targets, &scene);
+        let mut pairs = self.self_pairs.clone();
+        pairs.pairs.retain(|&(_, b)| b < self.robot_targets);
+        if self.params.self_collision {
+            pairs.pairs.extend(attached_pairs(&self.params, &targets, self.robot_targets, attached));
+            pairs.pairs.sort_unstable();
+        }
+        let mut checker = self.rebuilt(scene, allowed, pairs);
+        if targets.len() != self.robot_targets || self.targets.len() != self.robot_targets {
+            // Motion bounds and the joints a state must give follow the targets.
+            checker.moving = moving_joints(&self.robot, &targets);
+            checker.motion = std::sync::OnceLock::new();
+            checker.targets = targets;
+        }
+        Ok(checker)
+    }
+
+    /// The target of an attached object (none when `checked_links` leaves its id out), its
+    /// parts as a robot link's: a mesh as the hull of its vertices, grown by `padding` for its id.
+    fn attached_target(&self, a: &Attached) -> Result<Option<LinkTargets>, CheckerError> {
+        let refuse = |message: String| CheckerError::WorldObject { id: a.id.to_owned(), message };
+        let link = self.robot.link(a.link).ok_or_else(|| refuse(format!("link '{}' is not a link of the robot", a.link)))?;
+        if self.robot.link(a.id).is_some() || self.environment_frames.contains_key(a.id) {
+            return Err(refuse("the id names a link of the robot or the environment".into()));
+        }
+        if !self.params.is_checked(a.id) {
+            return Ok(None);
+        }
+        let padding = self.params.padding_of(a.id);
+        let parts = a
+            .shapes
+            .iter()
+            .enumerate()
+            .map(|(k, (shape, pose))| attached_part(shape, padding).map(|s| (s, *pose)).ok_or_else(|| refuse(format!("shape {k}: not a usable convex shape"))))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Some(LinkTargets { link, name: a.id.to_owned(), parts }))
+    }
+}
+
+/// The self pairs of the attached objects (targets from `first` on): each against every robot
+/// link but its own and its touch links, and against the objects attached to other links;
+/// `allowed_collisions` allows a pair either way round, as for two robot links.
+fn attached_pairs(params: &Params, targets: &[LinkTargets], first: usize, attached: &[Attached]) -> Vec<(usize, usize)> {
+    let mut pairs = Vec::new();
+    for b in first..targets.len() {
+        let Some(a_spec) = attached.iter().find(|a| a.id == targets[b].name) else { continue };
+        for (a, t) in targets[..b].iter().enumerate() {
+            let touch = a_spec.touch_links.iter().any(|l| *l == t.name);
+            let allowed = params.is_allowed(&t.name, &targets[b].name) || params.is_allowed(&targets[b].name, &t.name);
+            if t.link != targets[b].link && !touch && !allowed {
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs
 }
 
 #[cfg(test)]

@@ -164,6 +164,22 @@ fn kind(shape: &WorldShape) -> &'static str {
     }
 }
 
+/// A shape of an attached object as a robot link's part: a mesh as the hull of its vertices,
+/// every shape grown by `padding`; `None` when it is not a usable convex shape.
+pub(crate) fn attached_part(shape: &WorldShape, padding: f64) -> Option<TargetShape> {
+    let grown = |hull: Option<ConvexHull>| hull.and_then(|h| h.padded(padding)).map(|h| TargetShape::Polytope(Arc::new(h)));
+    match shape {
+        WorldShape::Box(size) => primitive_shape(&GeometrySpec::Box(*size), padding),
+        WorldShape::Sphere(r) => primitive_shape(&GeometrySpec::Sphere(*r), padding),
+        WorldShape::Cylinder { height, radius } => primitive_shape(&GeometrySpec::Cylinder { radius: *radius, length: *height }, padding),
+        WorldShape::Mesh(m) => grown(ConvexHull::from_points(&m.vertices)),
+        WorldShape::Cone { .. } | WorldShape::Prism { .. } => match solid(shape)? {
+            TargetShape::Polytope(h) => grown(Some((*h).clone())),
+            _ => None,
+        },
+    }
+}
+
 /// A primitive as a solid; `None` when its sizes are not positive and finite (a prism's polygon
 /// is taken as its convex hull).
 fn solid(shape: &WorldShape) -> Option<TargetShape> {

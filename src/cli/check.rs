@@ -171,6 +171,7 @@ fn emit(out: &mut impl Write, n: usize, checked: &CheckedState, json: bool) -> R
     for c in &report.contacts {
         let tri = match c.object_type {
             ObjectType::RobotLink => "robot link".to_string(),
+            ObjectType::AttachedObject => "attached object".to_string(),
             ObjectType::Environment if c.triangle == u32::MAX => "solid".to_string(),
             ObjectType::Environment => format!("triangle {}", c.triangle),
         };

@@ -170,8 +170,10 @@ pub struct ContactMsg {
     pub position: Point,
     /// Push-out direction.
     pub normal: Vector3,
-    /// [`ContactMsg::ENVIRONMENT`] or [`ContactMsg::ROBOT_LINK`].
+    /// [`ContactMsg::ENVIRONMENT`], [`ContactMsg::ROBOT_LINK`] or [`ContactMsg::ATTACHED_OBJECT`].
     pub object_type: u8,
+    /// What `link_name` is: [`ContactMsg::ROBOT_LINK`] or [`ContactMsg::ATTACHED_OBJECT`].
+    pub link_type: u8,
 }
 
 impl ContactMsg {
@@ -179,6 +181,8 @@ impl ContactMsg {
     pub const ENVIRONMENT: u8 = 0;
     /// `object_name` is another robot link (self-collision).
     pub const ROBOT_LINK: u8 = 1;
+    /// The body is an object attached to the robot (a planning scene's attached object).
+    pub const ATTACHED_OBJECT: u8 = 2;
 }
 
 /// `thickness_collision_msgs/msg/CollisionReport`.

@@ -154,6 +154,8 @@ impl Constraints {
 pub const BODY_ROBOT_LINK: u32 = 0;
 /// `moveit_msgs/msg/ContactInformation` `body_type` for a world object.
 pub const BODY_WORLD_OBJECT: u32 = 1;
+/// `moveit_msgs/msg/ContactInformation` `body_type` for an object attached to the robot.
+pub const BODY_ROBOT_ATTACHED: u32 = 2;
 
 /// `moveit_msgs/msg/ContactInformation`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]

@@ -49,6 +49,7 @@ pub fn report_message(report: &StateReport, stamp: Time, frame: &str) -> Collisi
         position: v(c.position.unwrap_or([f64::NAN; 3])),
         normal: v(c.normal),
         object_type: c.object_type.code(),
+        link_type: c.link_type.code(),
     };
     CollisionReport {
         header: Header { stamp, frame_id: frame.to_owned() },

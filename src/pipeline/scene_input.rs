@@ -7,9 +7,12 @@
 use super::scene_state::{FrameContext, SceneState};
 use super::skip::{Skip, SkipCause};
 use super::state_pipeline::Pipeline;
+use crate::checker::Checker;
 use crate::math::{pose_from_isometry, Pose};
+use crate::msgs::planning_scene::RobotStateMsg;
 use crate::msgs::planning_scene::{AttachedCollisionObject, CollisionObject, OctomapWithPose, PlanningScene, PlanningSceneWorld};
 use crate::msgs::Time;
+use std::sync::Arc;
 
 impl Pipeline {
     /// A `moveit_msgs/CollisionObject` (the `collision_object` topic).
@@ -31,15 +34,9 @@ impl Pipeline {
         self.change_scene(|s, ctx| s.apply_scene(ctx, msg))
     }
 
-    /// A `moveit_msgs/AttachedCollisionObject`: not supported yet, refused and counted (the
-    /// object is not checked: the log says so).
+    /// A `moveit_msgs/AttachedCollisionObject` (the `attached_collision_object` topic).
     pub(crate) fn attached_collision_object(&mut self, msg: &AttachedCollisionObject) -> Result<(), Skip> {
-        let skip = Skip {
-            cause: SkipCause::SceneUnsupported,
-            message: format!("attached collision object '{}' on link '{}': attached objects are not supported yet; not checked", msg.object.id, msg.link_name),
-        };
-        self.count_skip(skip.cause, 1);
-        Err(skip)
+        self.change_scene(|s, ctx| s.apply_attached(ctx, msg))
     }
 
     /// The scene in force as `get_planning_scene` answers (`components` as in
@@ -48,9 +45,33 @@ impl Pipeline {
         self.scene.message(&self.checker, components, stamp)
     }
 
-    /// Planning-scene objects in force.
-    pub fn scene_object_count(&self) -> usize {
-        self.scene.world.len()
+    /// The checker for a `check_state_validity` request's `robot_state` at joint positions `q`:
+    /// its attached objects placed at `q` on top of the node's (in their place when `is_diff` is
+    /// false). The checker in force when nothing changes; the reason when an object cannot be
+    /// attached.
+    pub(crate) fn request_checker(&self, state: &RobotStateMsg, q: &[f64]) -> Result<Arc<Checker>, String> {
+        if state.attached_collision_objects.is_empty() && (state.is_diff || self.scene.attached.is_empty()) {
+            return Ok(self.checker.clone());
+        }
+        let mut scene = self.scene.clone();
+        if !state.is_diff {
+            scene.attached.clear();
+        }
+        let robot = self.checker.robot();
+        let robot_links = || -> Result<Vec<Pose>, String> {
+            let poses = robot.forward_kinematics(q, self.checker.base_pose()).map_err(|e| e.to_string())?;
+            Ok(poses.iter().map(pose_from_isometry).collect())
+        };
+        let ctx = FrameContext { checker: &self.checker, robot_links: &robot_links };
+        for a in &state.attached_collision_objects {
+            scene.apply_attached(&ctx, a).map_err(|s| format!("robot_state.attached_collision_objects: {}", s.message))?;
+        }
+        self.checker.with_attached(&scene.attached_specs()).map(Arc::new).map_err(|e| format!("robot_state.attached_collision_objects: {e}"))
+    }
+
+    /// Planning-scene objects in force: in the world, and attached to the robot.
+    pub fn scene_object_count(&self) -> (usize, usize) {
+        (self.scene.world.len(), self.scene.attached.len())
     }
 
     /// An octomap (non-empty data) cannot be checked: refused with a warning the first time, and
@@ -74,7 +95,8 @@ impl Pipeline {
         let robot_links = || self.robot_link_poses();
         let result = change(&mut next, &FrameContext { checker: &self.checker, robot_links: &robot_links }).and_then(|()| {
             let objects = next.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
-            self.checker.with_world(objects, &mut self.bodies).map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() })
+            let attached = next.attached_specs();
+            self.checker.with_scene(objects, &attached, &mut self.bodies).map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() })
         });
         match result {
             Ok(checker) => {

@@ -9,10 +9,11 @@
 use super::collision_object::{object_to_add, pose_of, MAX_OBJECT_TRIANGLES};
 use super::planning_world::{PlanningWorld, WorldError};
 use super::skip::{Skip, SkipCause};
-use crate::checker::{Checker, WorldShape};
+use crate::checker::{Attached, Checker, WorldShape};
 use crate::math::Pose;
 use crate::msgs::planning_scene::{
-    CollisionObject, MeshTriangle, PlanningScene, PlanningSceneComponents, PlanningSceneWorld, Point32, Polygon, ShapeMesh, SolidPrimitive, MAX_SCENE_OBJECTS,
+    AttachedCollisionObject, CollisionObject, MeshTriangle, PlanningScene, PlanningSceneComponents, PlanningSceneWorld, Point32, Polygon, ShapeMesh,
+    SolidPrimitive, MAX_SCENE_OBJECTS,
 };
 use crate::msgs::{Header, Point, PoseMsg, Quaternion, Time, Transform, TransformStamped, Vector3};
 use std::collections::BTreeMap;
@@ -20,12 +21,24 @@ use std::collections::BTreeMap;
 /// Triangles the scene holds over all its objects.
 pub(crate) const MAX_SCENE_TRIANGLES: usize = 20_000_000;
 
-/// The world objects and fixed frames in force (the environment and robot are the checker's).
+/// The world objects, attached objects and fixed frames in force (the environment and robot are
+/// the checker's).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SceneState {
     pub(super) world: PlanningWorld<WorldShape>,
+    /// Objects attached to robot links, by id.
+    pub(super) attached: BTreeMap<String, AttachedObject>,
     /// `fixed_frame_transforms`: frames objects may be given in, by name, posed in the world.
     pub(super) fixed_frames: BTreeMap<String, Pose>,
+}
+
+/// An object attached to a robot link: it moves with the link.
+#[derive(Clone, Debug)]
+pub(crate) struct AttachedObject {
+    pub link: String,
+    /// Shapes with their poses in the link's frame.
+    pub shapes: Vec<(WorldShape, Pose)>,
+    pub touch_links: Vec<String>,
 }
 
 /// What the frames of a message are resolved against besides the scene: the checker (world
@@ -42,12 +55,17 @@ fn refuse(cause: SkipCause, message: String) -> Skip {
 
 impl SceneState {
     pub(super) fn is_empty(&self) -> bool {
-        self.world.len() == 0
+        self.world.len() == 0 && self.attached.is_empty()
+    }
+
+    /// The attached objects as the checker takes them.
+    pub(super) fn attached_specs(&self) -> Vec<Attached<'_>> {
+        self.attached.iter().map(|(id, a)| Attached { id, link: &a.link, shapes: &a.shapes, touch_links: &a.touch_links }).collect()
     }
 
     /// The pose in the world of `frame` (a leading `/` ignored): the world frame, a fixed frame,
     /// an object or `object/subframe`, an environment link, a robot link at the current state.
-    fn frame(&self, ctx: &FrameContext, frame: &str, id: &str) -> Result<Pose, Skip> {
+    pub(super) fn frame(&self, ctx: &FrameContext, frame: &str, id: &str) -> Result<Pose, Skip> {
         let name = frame.strip_prefix('/').unwrap_or(frame);
         let world = &ctx.checker.params().world_frame;
         if name == world {
@@ -134,7 +152,7 @@ impl SceneState {
     }
 
     /// The scene's bounds after an object `id` grew: objects, and triangles per object and in all.
-    fn check_bounds(&self, id: &str) -> Result<(), Skip> {
+    pub(super) fn check_bounds(&self, id: &str) -> Result<(), Skip> {
         if self.world.len() > MAX_SCENE_OBJECTS {
             return Err(refuse(SkipCause::SceneBounds, format!("collision object '{id}': the scene would hold more than {MAX_SCENE_OBJECTS} objects")));
         }
@@ -164,12 +182,14 @@ impl SceneState {
         msg.collision_objects.iter().try_for_each(|o| self.apply_object(ctx, o))
     }
 
-    /// A `PlanningScene`, a difference (`is_diff`) or the whole scene. What it holds that is not
-    /// supported yet refuses it whole (an attached object, allowed collision entries, link
-    /// padding or scale: ignoring them would check against a scene the planner does not have).
+    /// A `PlanningScene`, a difference (`is_diff`) or the whole scene, in MoveIt's order: fixed
+    /// frames, the robot state's attached objects (all replaced when `robot_state.is_diff` is
+    /// false), world objects. What it holds that is not supported yet refuses it whole (allowed
+    /// collision entries, link padding or scale: ignoring them would check against a scene the
+    /// planner does not have). The robot state's joint positions are not used: states come from
+    /// `joint_states`.
     pub(super) fn apply_scene(&mut self, ctx: &FrameContext, msg: &PlanningScene) -> Result<(), Skip> {
         let unsupported = [
-            (!msg.robot_state.attached_collision_objects.is_empty(), "robot_state.attached_collision_objects"),
             (!msg.allowed_collision_matrix.entry_names.is_empty() || !msg.allowed_collision_matrix.default_entry_names.is_empty(), "allowed_collision_matrix"),
             (!msg.link_padding.is_empty(), "link_padding"),
             (!msg.link_scale.is_empty(), "link_scale"),
@@ -194,6 +214,13 @@ impl SceneState {
             })?;
             let _ = self.fixed_frames.insert(t.child_frame_id.clone(), pose);
         }
+        let state = &msg.robot_state;
+        if !(state.attached_collision_objects.is_empty() && state.joint_state.name.is_empty() && state.multi_dof_joint_state.joint_names.is_empty()) {
+            if !state.is_diff {
+                self.attached.clear();
+            }
+            state.attached_collision_objects.iter().try_for_each(|a| self.apply_attached(ctx, a))?;
+        }
         msg.world.collision_objects.iter().try_for_each(|o| self.apply_object(ctx, o))
     }
 
@@ -217,6 +244,19 @@ impl SceneState {
                         (msg.subframe_names, msg.subframe_poses) = o.subframes.iter().map(|(n, p)| (n.clone(), pose_msg(p))).unzip();
                     }
                     msg
+                })
+                .collect();
+        }
+        if components & PlanningSceneComponents::ROBOT_STATE_ATTACHED_OBJECTS != 0 {
+            scene.robot_state.attached_collision_objects = self
+                .attached
+                .iter()
+                .map(|(id, a)| {
+                    let link_header = Header { stamp, frame_id: a.link.clone() };
+                    let mut object = CollisionObject { header: link_header, id: id.clone(), operation: CollisionObject::ADD, ..Default::default() };
+                    object.pose = pose_msg(&Pose::IDENTITY);
+                    fill_shapes(&mut object, &a.shapes);
+                    AttachedCollisionObject { link_name: a.link.clone(), object, touch_links: a.touch_links.clone(), ..Default::default() }
                 })
                 .collect();
         }

@@ -69,7 +69,7 @@ fn moving_and_re_adding_an_object_reuses_its_cells() {
     // A different thickness is another body.
     p.set_params(Params { default_thickness: 0.05, ..Params::default() }).unwrap();
     assert_eq!(p.bodies.built, 2, "new parameters rebuild the object's cells");
-    assert_eq!(p.scene_object_count(), 1, "and keep the object");
+    assert_eq!(p.scene_object_count(), (1, 0), "and keep the object");
 }
 
 /// Frames: an environment link, an object and its subframe, a fixed frame, a robot link at the
@@ -147,7 +147,7 @@ fn scenes_apply_whole_and_travel_back() {
         ..Default::default()
     };
     assert_eq!(p.planning_scene(&half).unwrap_err().cause, SkipCause::SceneId);
-    assert_eq!(p.scene_object_count(), 1);
+    assert_eq!(p.scene_object_count(), (1, 0));
     p.collision_object(&crate_box).unwrap();
     let all = PlanningSceneComponents::WORLD_OBJECT_GEOMETRY | PlanningSceneComponents::TRANSFORMS;
     let msg = p.planning_scene_message(all, Time::default());
@@ -155,7 +155,7 @@ fn scenes_apply_whole_and_travel_back() {
     let mut fresh = Pipeline::new(Params::default()).unwrap();
     fresh.collision_object(&sheet_at(9.0, 9.0, 9.0)).unwrap();
     fresh.planning_scene(&msg).unwrap();
-    assert_eq!(fresh.scene_object_count(), 2, "is_diff false replaced the fresh pipeline's scene");
+    assert_eq!(fresh.scene_object_count(), (2, 0), "is_diff false replaced the fresh pipeline's scene");
     assert_eq!(reports(&fresh), reports(&p));
     // A new robot (the same URDF, as a description) keeps the world objects.
     let urdf = std::fs::read_to_string(Params::default().robot_path()).unwrap().replace(
@@ -164,9 +164,102 @@ fn scenes_apply_whole_and_travel_back() {
     );
     let before = reports(&p);
     p.set_robot_description(&urdf, "test").unwrap();
-    assert_eq!(p.scene_object_count(), 2);
+    assert_eq!(p.scene_object_count(), (2, 0));
     assert_eq!(reports(&p), before);
     // The names-only answer has ids and poses, no shapes.
     let names = p.planning_scene_message(PlanningSceneComponents::WORLD_OBJECT_NAMES, Time::default());
     assert!(names.world.collision_objects.iter().all(|o| o.primitives.is_empty() && o.meshes.is_empty()));
+}
+
+/// An object attached to `tool0` with touch links is checked exactly as a fixed child link of
+/// `tool0` with the same geometry, in a robot whose SRDF disables each touch link's pair with it:
+/// the same contacts (the object named by its id, its type `attached_object`) for random states;
+/// detached, it stays in the world where it was.
+#[test]
+fn an_attached_object_is_checked_as_a_fixed_child_link() {
+    use crate::checker::{Checker, ObjectType};
+    use crate::model::{PackageResolver, RobotModel};
+    use crate::msgs::planning_scene::AttachedCollisionObject;
+    use std::fmt::Write as _;
+    let dir = std::env::temp_dir().join(format!("tc_attached_twin_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // An SRDF that disables what the default reasoning allows, so both sides use one matrix.
+    let plain = Checker::from_params(Params::default()).unwrap();
+    let targets = plain.targets();
+    let mut srdf = String::from("<robot name=\"tc_arm\">");
+    for a in 0..targets.len() {
+        for b in a + 1..targets.len() {
+            if !plain.self_pairs().pairs.contains(&(a, b)) {
+                let _ = write!(srdf, "<disable_collisions link1=\"{}\" link2=\"{}\" reason=\"Default\"/>", targets[a].name, targets[b].name);
+            }
+        }
+    }
+    let touch = ["gripper_link", "finger_left_link", "finger_right_link"];
+    let twin_srdf = touch.iter().fold(srdf.clone(), |s, l| s + &format!("<disable_collisions link1=\"tray\" link2=\"{l}\" reason=\"Touch\"/>")) + "</robot>";
+    let srdf = srdf + "</robot>";
+    std::fs::write(dir.join("arm.srdf"), &srdf).unwrap();
+    let params = Params { robot_semantic_file: dir.join("arm.srdf").display().to_string(), ..Params::default() };
+    let mut p = Pipeline::new(params.clone()).unwrap();
+    let q0 = [0.0, -0.5, 0.8, 0.0, 0.3, 0.0, 0.01];
+    let _ = p.joint_state(&JointState { name: ARM.iter().map(|s| s.to_string()).collect(), position: q0.to_vec(), ..Default::default() }).unwrap();
+    let tray = CollisionObject {
+        pose: at(0.0, 0.0, 0.12),
+        primitives: vec![
+            SolidPrimitive { kind: SolidPrimitive::BOX, dimensions: vec![0.3, 0.2, 0.04], ..Default::default() },
+            SolidPrimitive { kind: SolidPrimitive::SPHERE, dimensions: vec![0.06], ..Default::default() },
+        ],
+        primitive_poses: vec![at(0.0, 0.0, 0.0), at(0.1, 0.0, 0.05)],
+        ..object("tool0", "tray", CollisionObject::ADD)
+    };
+    let attach =
+        AttachedCollisionObject { link_name: "tool0".into(), object: tray, touch_links: touch.iter().map(|s| s.to_string()).collect(), ..Default::default() };
+    p.attached_collision_object(&attach).unwrap();
+    assert_eq!(p.scene_object_count(), (0, 1));
+    // The twin: the robot URDF with a fixed child link "tray" of tool0.
+    let robot_path = params.robot_path();
+    let link = "<link name=\"tray\"><collision><origin xyz=\"0 0 0.12\"/><geometry><box size=\"0.3 0.2 0.04\"/></geometry></collision><collision><origin xyz=\"0.1 0 0.17\"/><geometry><sphere radius=\"0.06\"/></geometry></collision></link><joint name=\"tray_joint\" type=\"fixed\"><parent link=\"tool0\"/><child link=\"tray\"/></joint></robot>";
+    let text = std::fs::read_to_string(&robot_path).unwrap().replacen("</robot>", link, 1);
+    let resolver = PackageResolver::default();
+    let robot = RobotModel::from_str(&text, "twin.urdf", robot_path.parent().unwrap(), &resolver, false).unwrap();
+    let env = RobotModel::from_file(&params.environment_path(), &resolver, false).unwrap();
+    let twin = Checker::from_models(params, robot, env, "twin".into(), "env".into(), Some(&twin_srdf)).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let names: Vec<String> = ARM.iter().map(|s| s.to_string()).collect();
+    let mut rng = oorandom::Rand64::new(11);
+    let (mut with_tray, mut tray_self) = (0, 0);
+    for _ in 0..400 {
+        let q: Vec<f64> = ARM.iter().map(|_| -2.5 + 5.0 * rng.rand_float()).collect();
+        let (a, b) = (p.checker().check_joints(&names, &q).unwrap(), twin.check_joints(&names, &q).unwrap());
+        // The same bodies, depths to 1e-9 (the object's pose went through its link's inverse
+        // and back); triangle, point and normal the same unless another cell is as deep (a face
+        // of the box flat against the sheet: rounding picks one of the tied cells).
+        let names = |r: &crate::checker::StateReport| r.contacts.iter().map(|c| (c.link_name.clone(), c.object_name.clone())).collect::<Vec<_>>();
+        assert_eq!(names(&a), names(&b), "at {q:?}");
+        for (x, y) in a.contacts.iter().zip(&b.contacts) {
+            let close = |u: &[f64], v: &[f64]| u.iter().zip(v).all(|(p, q)| (p - q).abs() < 1e-9);
+            let (px, py) = (x.position.unwrap_or_default(), y.position.unwrap_or_default());
+            assert!(close(&[x.depth], &[y.depth]), "at {q:?}: {x:?} vs {y:?}");
+            assert!(x.triangle != y.triangle || (close(&px, &py) && close(&x.normal, &y.normal)), "at {q:?}: {x:?} vs {y:?}");
+        }
+        for c in &a.contacts {
+            let tray_type = |name: &str, kind: ObjectType| name != "tray" || kind == ObjectType::AttachedObject;
+            assert!(tray_type(&c.link_name, c.link_type) && tray_type(&c.object_name, c.object_type), "{c:?}");
+        }
+        with_tray += a.contacts.iter().any(|c| c.link_name == "tray") as usize;
+        tray_self += a.contacts.iter().any(|c| c.object_name == "tray") as usize;
+    }
+    assert!(with_tray > 10 && tray_self > 3, "{with_tray} states with the tray against the world, {tray_self} against the arm: the cases must mix");
+    // Detached: in the world where it is, no longer moving with the arm.
+    let detach = AttachedCollisionObject { link_name: "tool0".into(), object: object("", "tray", CollisionObject::REMOVE), ..Default::default() };
+    p.attached_collision_object(&detach).unwrap();
+    assert_eq!(p.scene_object_count(), (1, 0));
+    let robot = p.checker().robot();
+    let mut all = vec![0.0; robot.joints.len()];
+    for (name, v) in ARM.iter().zip(q0) {
+        all[robot.joint(name).unwrap()] = v;
+    }
+    let tool = pose_from_isometry(&robot.forward_kinematics(&all, p.checker().base_pose()).unwrap()[robot.link("tool0").unwrap()]);
+    let world_tray = p.scene.world.get("tray").unwrap();
+    let box_pose = world_tray.pose * world_tray.shapes[0].1;
+    assert!((box_pose.translation - (tool * Pose::from_translation(Vector::new(0.0, 0.0, 0.12))).translation).length() < 1e-12);
 }

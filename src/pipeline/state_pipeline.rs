@@ -472,10 +472,11 @@ impl Pipeline {
             checker
         } else {
             let objects = self.scene.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
-            match checker.with_world(objects, &mut self.bodies) {
+            match checker.with_scene(objects, &self.scene.attached_specs(), &mut self.bodies) {
                 Ok(with) => with,
                 Err(e) => {
-                    self.warnings.push(format!("the planning scene's {} objects are dropped: {e}", self.scene.world.len()));
+                    let (world, attached) = (self.scene.world.len(), self.scene.attached.len());
+                    self.warnings.push(format!("the planning scene's {world} world and {attached} attached objects are dropped: {e}"));
                     self.scene = SceneState::default();
                     checker
                 }

@@ -17,9 +17,13 @@
 //!
 //! The response has no text field, so a request the node cannot honour is answered `valid =
 //! false` with no contacts, and the reason is handed back beside the response for the front door
-//! to log and count: attached collision objects, multi-DOF joints (the node cannot place them from
-//! a request), non-empty constraints, a non-finite position, an unknown or repeated joint, lengths
-//! that differ. Nothing in a request is silently ignored.
+//! to log and count: multi-DOF joints (the node cannot place them from a request), non-empty
+//! constraints, a non-finite position, an unknown or repeated joint, lengths that differ, an
+//! attached object that cannot be placed. Nothing in a request is silently ignored.
+//! - `robot_state.attached_collision_objects` are attached at the request's state for this
+//!   request only, on top of the node's attached objects, or in their place when
+//!   `robot_state.is_diff` is false (as MoveIt's `robotStateMsgToRobotState` does); contacts of an
+//!   attached object have `ROBOT_ATTACHED` body types.
 //!
 //! As for `check_trajectory`, the work is split so the node can check off its event loop:
 //! [`Pipeline::validity_job`] validates and resolves (linear in the request, no geometry) and
@@ -29,7 +33,7 @@ use super::Pipeline;
 use crate::checker::{Checker, ObjectType, ReportContact};
 use crate::limits::name_list;
 use crate::model::RobotModel;
-use crate::msgs::moveit::{ContactInformation, GetStateValidityRequest, GetStateValidityResponse, BODY_ROBOT_LINK, BODY_WORLD_OBJECT};
+use crate::msgs::moveit::{ContactInformation, GetStateValidityRequest, GetStateValidityResponse, BODY_ROBOT_ATTACHED, BODY_ROBOT_LINK, BODY_WORLD_OBJECT};
 use crate::msgs::{Header, Time, Vector3};
 use std::sync::Arc;
 
@@ -66,7 +70,14 @@ impl Pipeline {
     pub(crate) fn validity_job(&self, req: &GetStateValidityRequest) -> ValidityJob {
         let (links, warning) = group_links(self.checker(), &req.group_name);
         let plan = refusal(self.checker().robot(), req).map_or_else(|| resolve(self, req).map(|q| Plan { q, links }), Err);
-        ValidityJob { checker: self.checker().clone(), plan, stamp: req.robot_state.joint_state.header.stamp, warning }
+        let checker = match &plan {
+            Ok(p) => self.request_checker(&req.robot_state, &p.q),
+            Err(_) => Ok(self.checker().clone()),
+        };
+        match checker {
+            Ok(checker) => ValidityJob { checker, plan, stamp: req.robot_state.joint_state.header.stamp, warning },
+            Err(e) => ValidityJob { checker: self.checker().clone(), plan: Err(e), stamp: req.robot_state.joint_state.header.stamp, warning },
+        }
     }
 
     /// A `check_state_validity` request answered on this thread: the response, and why the
@@ -76,18 +87,10 @@ impl Pipeline {
     }
 }
 
-/// What the node cannot honour in a request, before the joint state is looked at: attached
-/// objects, multi-DOF joints, constraints.
+/// What the node cannot honour in a request, before the joint state is looked at: multi-DOF
+/// joints, constraints.
 fn refusal(robot: &RobotModel, req: &GetStateValidityRequest) -> Option<String> {
     let state = &req.robot_state;
-    if let Some(first) = state.attached_collision_objects.first() {
-        return Some(format!(
-            "robot_state has {} attached collision object(s) (the first '{}' on link '{}'); the node does not check attached objects",
-            state.attached_collision_objects.len(),
-            first.object.id,
-            first.link_name
-        ));
-    }
     let multi = &state.multi_dof_joint_state;
     if !multi.joint_names.is_empty() || !multi.transforms.is_empty() {
         let (known, unknown): (Vec<&String>, Vec<&String>) = multi.joint_names.iter().partition(|n| robot.joint(n).is_some());
@@ -212,25 +215,37 @@ impl ValidityJob {
             Err(e) => return (refused(), Some(format!("the state could not be checked: {e}"))),
         };
         let robot = self.checker.robot();
-        let covered = |link: &str| match (&plan.links, robot.link(link)) {
-            (None, _) => true,
-            (Some(set), Some(l)) => set[l],
-            (Some(_), None) => false,
+        // A body of the robot is covered when its link is (an attached object's: the link it is on).
+        let covered = |name: &str, kind: ObjectType| {
+            let link = match kind {
+                ObjectType::RobotLink => robot.link(name),
+                ObjectType::AttachedObject => self.checker.targets().iter().rev().find(|t| t.name == name).map(|t| t.link),
+                ObjectType::Environment => None,
+            };
+            match (&plan.links, link) {
+                (None, _) => true,
+                (Some(set), Some(l)) => set[l],
+                (Some(_), None) => false,
+            }
         };
         let frame = &self.checker.params().world_frame;
         let contacts: Vec<ContactInformation> = report
             .contacts
             .iter()
-            .filter(|c| covered(&c.link_name) || (is_self_contact(c) && covered(&c.object_name)))
+            .filter(|c| covered(&c.link_name, c.link_type) || covered(&c.object_name, c.object_type))
             .map(|c| contact(c, frame, self.stamp))
             .collect();
         (GetStateValidityResponse { valid: contacts.is_empty(), contacts, ..Default::default() }, None)
     }
 }
 
-/// Whether a contact is between two robot links (self-collision).
-fn is_self_contact(c: &ReportContact) -> bool {
-    c.object_type == ObjectType::RobotLink
+/// A body type of a report as `ContactInformation`'s.
+fn body_type(kind: ObjectType) -> u32 {
+    match kind {
+        ObjectType::RobotLink => BODY_ROBOT_LINK,
+        ObjectType::AttachedObject => BODY_ROBOT_ATTACHED,
+        ObjectType::Environment => BODY_WORLD_OBJECT,
+    }
 }
 
 /// A report contact as `moveit_msgs/ContactInformation`: body 1 the robot link, body 2 the
@@ -245,9 +260,9 @@ fn contact(c: &ReportContact, frame: &str, stamp: Time) -> ContactInformation {
         normal: v(c.normal),
         depth: c.depth,
         contact_body_1: c.link_name.clone(),
-        body_type_1: BODY_ROBOT_LINK,
+        body_type_1: body_type(c.link_type),
         contact_body_2: c.object_name.clone(),
-        body_type_2: if is_self_contact(c) { BODY_ROBOT_LINK } else { BODY_WORLD_OBJECT },
+        body_type_2: body_type(c.object_type),
     }
 }
 
@@ -296,7 +311,7 @@ mod tests {
         let mut multi_unknown = multi.clone();
         multi_unknown.robot_state.multi_dof_joint_state.joint_names[0] = "virtual_joint".into();
         let cases = [
-            (attached, "attached collision object"),
+            (attached, "attached collision object '' on link 'tool0': id: an object to attach needs an id"),
             (constrained, "1 joint, 0 position"),
             (multi, "cannot place multi-DOF joints"),
             (multi_unknown, "'virtual_joint' is not a joint"),

@@ -264,6 +264,7 @@ mod tests {
                 position: Some([0.0; 3]),
                 normal: [0.0, 0.0, 1.0],
                 object_type: Default::default(),
+                link_type: crate::checker::ObjectType::RobotLink,
             })
             .collect::<Vec<_>>();
         StateReport { in_collision: !contacts.is_empty(), contacts, ..Default::default() }
