@@ -3,10 +3,13 @@
 //! recording looks like the running node.
 
 use crate::checker::{Checker, StateReport};
+use crate::collision::{ObjectBody, TargetShape};
 use crate::msgs::{ColorRgba, DurationMsg, Header, Marker, MarkerArray, Point, PoseMsg, Time, Vector3};
 
 /// `visualization_msgs/Marker` types and actions used here.
 const ARROW: i32 = 0;
+const SPHERE: i32 = 2;
+const CYLINDER: i32 = 3;
 const SPHERE_LIST: i32 = 7;
 const TEXT_VIEW_FACING: i32 = 9;
 const TRIANGLE_LIST: i32 = 11;
@@ -27,10 +30,13 @@ fn header(frame: &str, stamp: Time) -> Header {
     Header { stamp, frame_id: frame.to_owned() }
 }
 
-/// One triangle-list marker per thin surface with the faces of its cells (world frame), at most
-/// `max_cells` cells in all (the first ones of each object in turn).
+/// The scene for a viewer: a `DELETEALL` first (an object removed from the planning scene
+/// disappears), then one triangle-list marker per thin surface with the faces of its cells (world
+/// frame, namespace `cells/<object>`), at most `max_cells` cells in all (the first ones of each
+/// object in turn), and one marker per convex solid (namespace `solids/<object>`: a sphere or
+/// cylinder, or the hull's triangles).
 pub(crate) fn cell_markers(checker: &Checker, max_cells: usize, frame: &str, stamp: Time) -> MarkerArray {
-    let mut markers = Vec::new();
+    let mut markers = vec![Marker { header: header(frame, stamp), action: DELETEALL, pose: PoseMsg::default(), ..Default::default() }];
     let mut left = max_cells;
     for (id, object) in checker.scene().objects().iter().enumerate() {
         let Some(area) = object.area() else { continue };
@@ -58,7 +64,34 @@ pub(crate) fn cell_markers(checker: &Checker, max_cells: usize, frame: &str, sta
             ..Default::default()
         });
     }
+    for (id, object) in checker.scene().objects().iter().enumerate() {
+        let ObjectBody::Solid(shape) = &*object.body else { continue };
+        markers.push(solid_marker(
+            shape,
+            &object.pose,
+            Marker { header: header(frame, stamp), ns: format!("solids/{}", object.name), id: id as i32, ..Default::default() },
+        ));
+    }
     MarkerArray { markers }
+}
+
+/// A convex solid at `pose` as a marker (`base` gives header, namespace and id): a sphere, a
+/// cylinder (a capsule drawn as the cylinder around it), or a polytope's triangles in the world.
+fn solid_marker(shape: &TargetShape, pose: &crate::math::Pose, base: Marker) -> Marker {
+    let color = ColorRgba { r: 0.45, g: 0.55, b: 0.7, a: 0.5 };
+    let (t, r) = (pose.translation, pose.rotation);
+    let at = PoseMsg { position: Point { x: t.x, y: t.y, z: t.z }, orientation: crate::msgs::Quaternion { x: r.x, y: r.y, z: r.z, w: r.w } };
+    let round = |kind: i32, d: f64, h: f64| Marker { kind, pose: at, scale: Vector3 { x: d, y: d, z: h }, color, ..base.clone() };
+    match shape {
+        TargetShape::Sphere { radius } => round(SPHERE, 2.0 * radius, 2.0 * radius),
+        TargetShape::Cylinder { half_height, radius } => round(CYLINDER, 2.0 * radius, 2.0 * half_height),
+        TargetShape::Capsule { half_height, radius } => round(CYLINDER, 2.0 * radius, 2.0 * (half_height + radius)),
+        TargetShape::Polytope(hull) => {
+            let (v, tris) = hull.vertices_and_triangles();
+            let points = tris.iter().flatten().map(|&i| point(*pose * crate::math::Vector::from_array(v[i as usize]))).collect();
+            Marker { kind: TRIANGLE_LIST, pose: PoseMsg::default(), scale: Vector3 { x: 1.0, y: 1.0, z: 1.0 }, color, points, ..base }
+        }
+    }
 }
 
 /// Yellow at depth 0 to red at [`FULL_DEPTH_COLOR`] and beyond.

@@ -226,7 +226,10 @@ fn fastdds_topics_services_parameters_and_latched_markers() {
     // The latched cells, read by a reader created now (a late joiner, as RViz is), and the status.
     let t_latched = std::time::Instant::now();
     let a = peer.send(&json!({"cmd": "latched", "timeout": 60}));
-    let cells = a["cells"].as_array().unwrap_or_else(|| panic!("no cell markers within 60 s: {a}"));
+    let all = a["cells"].as_array().unwrap_or_else(|| panic!("no cell markers within 60 s: {a}"));
+    assert_eq!((&all[0]["ns"], &all[0]["points"]), (&json!(""), &json!(0)), "a DELETEALL first: {a}");
+    assert!(all.iter().any(|m| m["ns"] == "solids/table"), "the table (a solid) is drawn: {a}");
+    let cells: Vec<&serde_json::Value> = all.iter().filter(|m| m["ns"].as_str().unwrap_or_default().starts_with("cells/")).collect();
     assert_eq!(cells.len(), 3, "one triangle list per thin surface: {a}");
     assert!(cells.iter().all(|m| m["type"] == 11 && m["frame"] == "world"), "{a}");
     let triangles: u64 = cells.iter().map(|m| m["points"].as_u64().unwrap() / 3).sum();

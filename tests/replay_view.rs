@@ -177,7 +177,10 @@ fn replay_writes_markers_tf_description_and_a_timeline() {
     let cells = view["cells"].as_array().unwrap();
     assert_eq!(cells.len(), 1);
     assert_eq!(cells[0]["log_time"].as_i64(), Some(log_time(0)));
-    let markers = cells[0]["markers"].as_array().unwrap();
+    let all = cells[0]["markers"].as_array().unwrap();
+    assert_eq!(all[0]["action"], 3, "a DELETEALL first: {:?}", all[0]);
+    assert!(all.iter().any(|m| m["ns"] == "solids/table"), "the table (a solid) is drawn");
+    let markers: Vec<&Value> = all.iter().filter(|m| m["ns"].as_str().unwrap_or_default().starts_with("cells/")).collect();
     assert_eq!(markers.len(), 3, "one triangle list per thin surface");
     assert!(markers.iter().all(|m| m["type"] == 11 && m["frame_id"] == "world"));
     assert_eq!(markers.iter().map(|m| m["points"].as_u64().unwrap() / 3).sum::<u64>(), 8 * 4112);

@@ -87,7 +87,10 @@ fn reports_over_dds_equal_check_and_bad_input_is_skipped() {
     eprintln!("node RSS: {} KiB before, {} KiB after a 10,000-state burst and the bad messages", rss_before, rss_after);
     assert!(rss_before > 0 && rss_after < rss_before + 50 * 1024, "resident memory grew by more than 50 MiB");
     // The cells as RViz markers (latched: a late subscriber gets them), and the status.
-    let cells = answer["cells_markers"].as_array().unwrap_or_else(|| panic!("no cell markers: {answer}"));
+    let all = answer["cells_markers"].as_array().unwrap_or_else(|| panic!("no cell markers: {answer}"));
+    assert_eq!((&all[0]["ns"], &all[0]["points"]), (&json!(""), &json!(0)), "a DELETEALL first: {:?}", all[0]);
+    assert!(all.iter().any(|m| m["ns"] == "solids/table"), "the table (a solid) is drawn: {all:?}");
+    let cells: Vec<&serde_json::Value> = all.iter().filter(|m| m["ns"].as_str().unwrap_or_default().starts_with("cells/")).collect();
     assert_eq!(cells.len(), 3, "one triangle list per thin surface");
     let triangles: u64 = cells.iter().map(|m| m["points"].as_u64().unwrap() / 3).sum();
     assert_eq!(triangles, 8 * 4112, "8 triangles per cell, every cell of the workcell (under marker_max_cells)");

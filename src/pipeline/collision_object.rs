@@ -87,6 +87,12 @@ fn primitive(p: &SolidPrimitive, id: &str, k: usize) -> Result<WorldShape, Strin
             Err(format!("collision object '{id}': primitives[{k}]: a {what} takes {n} dimensions, the message gives {}", d.len()))
         }
     };
+    // The sizes URDF primitives may have: past 1e4 m contact arithmetic loses its precision,
+    // below 1e-6 m a shape is degenerate.
+    let [lo, hi] = crate::limits::LENGTH_RANGE;
+    if let Some((i, v)) = d.iter().enumerate().find(|(_, v)| !(lo..=hi).contains(*v)) {
+        return Err(format!("collision object '{id}': primitives[{k}].dimensions[{i}]: {v} is not a size from {lo} to {hi} m"));
+    }
     let shape = match p.kind {
         SolidPrimitive::BOX => need(3, "box").map(|_| WorldShape::Box([d[0], d[1], d[2]])),
         SolidPrimitive::SPHERE => need(1, "sphere").map(|_| WorldShape::Sphere(d[0])),
@@ -95,6 +101,9 @@ fn primitive(p: &SolidPrimitive, id: &str, k: usize) -> Result<WorldShape, Strin
         SolidPrimitive::PRISM => {
             need(1, "prism")?;
             let polygon: Vec<[f64; 2]> = p.polygon.points.iter().map(|q| [q.x as f64, q.y as f64]).collect();
+            if let Some(i) = polygon.iter().position(|[x, y]| !(x.is_finite() && y.is_finite() && x.abs() <= hi && y.abs() <= hi)) {
+                return Err(format!("collision object '{id}': primitives[{k}].polygon.points[{i}]: not finite within {hi} m"));
+            }
             if polygon.len() < 3 {
                 return Err(format!("collision object '{id}': primitives[{k}]: a prism's polygon needs 3 points or more, the message gives {}", polygon.len()));
             }
@@ -179,6 +188,11 @@ mod tests {
                 "primitives[0]: a box takes 3 dimensions, the message gives 1",
             ),
             (CollisionObject { primitives: vec![primitive(9, &[0.1])], ..base.clone() }, "primitives[0]: type 9 is not a shape"),
+            (
+                CollisionObject { primitives: vec![primitive(SolidPrimitive::SPHERE, &[1e154])], ..base.clone() },
+                "primitives[0].dimensions[0]: 1e154 is not a size",
+            ),
+            (CollisionObject { primitives: vec![primitive(SolidPrimitive::BOX, &[0.1, 0.0, 0.1])], ..base.clone() }, "dimensions[1]: 0 is not a size"),
             (CollisionObject { primitives: vec![primitive(SolidPrimitive::PRISM, &[0.1])], ..base.clone() }, "a prism's polygon needs 3 points"),
             (CollisionObject { primitive_poses: vec![pose(0.0)], ..base.clone() }, "primitive_poses: 1 poses for 0 shapes"),
             (CollisionObject { planes: vec![Default::default()], ..base.clone() }, "planes: not supported yet"),

@@ -37,8 +37,7 @@ impl SceneState {
     fn link_pose(ctx: &FrameContext, link: &str, what: &str) -> Result<Pose, Skip> {
         let li =
             ctx.checker.robot().link(link).ok_or_else(|| refuse(SkipCause::SceneFrame, format!("{what}: link_name: '{link}' is not a link of the robot")))?;
-        let poses = (ctx.robot_links)().map_err(|e| refuse(SkipCause::SceneFrame, format!("{what}: the link cannot be placed: {e}")))?;
-        poses.get(li).copied().ok_or_else(|| refuse(SkipCause::SceneFrame, format!("{what}: no pose for link '{link}'")))
+        (ctx.robot_link)(li).map_err(|e| refuse(SkipCause::SceneFrame, format!("{what}: the link cannot be placed: {e}")))
     }
 
     fn attach(&mut self, ctx: &FrameContext, msg: &AttachedCollisionObject, what: &str) -> Result<(), Skip> {

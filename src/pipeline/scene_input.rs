@@ -9,6 +9,7 @@ use super::skip::{Skip, SkipCause};
 use super::state_pipeline::Pipeline;
 use crate::checker::Checker;
 use crate::math::{pose_from_isometry, Pose};
+use crate::model::PoseSource;
 use crate::msgs::planning_scene::RobotStateMsg;
 use crate::msgs::planning_scene::{AttachedCollisionObject, CollisionObject, OctomapWithPose, PlanningScene, PlanningSceneWorld};
 use crate::msgs::Time;
@@ -58,11 +59,9 @@ impl Pipeline {
             scene.attached.clear();
         }
         let robot = self.checker.robot();
-        let robot_links = || -> Result<Vec<Pose>, String> {
-            let poses = robot.forward_kinematics(q, self.checker.base_pose()).map_err(|e| e.to_string())?;
-            Ok(poses.iter().map(pose_from_isometry).collect())
-        };
-        let ctx = FrameContext { checker: &self.checker, robot_links: &robot_links };
+        let poses = robot.forward_kinematics(q, self.checker.base_pose()).map_err(|e| e.to_string())?;
+        let robot_link = |li: usize| poses.get(li).map(pose_from_isometry).ok_or_else(|| format!("no pose for link {li}"));
+        let ctx = FrameContext { checker: &self.checker, robot_link: &robot_link };
         for a in &state.attached_collision_objects {
             scene.apply_attached(&ctx, a).map_err(|s| format!("robot_state.attached_collision_objects: {}", s.message))?;
         }
@@ -92,8 +91,8 @@ impl Pipeline {
     /// the new scene is built, puts both in force.
     fn change_scene(&mut self, change: impl FnOnce(&mut SceneState, &FrameContext) -> Result<(), Skip>) -> Result<(), Skip> {
         let mut next = self.scene.clone();
-        let robot_links = || self.robot_link_poses();
-        let result = change(&mut next, &FrameContext { checker: &self.checker, robot_links: &robot_links }).and_then(|()| {
+        let robot_link = |li| self.robot_link_pose(li);
+        let result = change(&mut next, &FrameContext { checker: &self.checker, robot_link: &robot_link }).and_then(|()| {
             let objects = next.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
             let attached = next.attached_specs();
             self.checker.with_scene(objects, &attached, &mut self.bodies).map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() })
@@ -111,13 +110,19 @@ impl Pipeline {
         }
     }
 
-    /// The robot's link poses in the world at the merged joint state (a joint never received
-    /// as the `missing_joint` rule has it), as MoveIt places an object given in a robot link's
-    /// frame at its current state.
-    fn robot_link_poses(&self) -> Result<Vec<Pose>, String> {
-        let robot = self.checker.robot();
+    /// The world pose of robot link `li` in the robot's current state, as MoveIt places an object
+    /// given in a robot link's frame at its current state: from the merged joint state (a joint
+    /// never received as the `missing_joint` rule has it), or with `pose_source: tf` from the TF
+    /// tree.
+    fn robot_link_pose(&self, li: usize) -> Result<Pose, String> {
+        let (checker, params) = (&self.checker, self.params());
+        let robot = checker.robot();
+        if params.pose_source == PoseSource::Tf {
+            let frame = format!("{}{}", params.frame_prefix, robot.links[li].name);
+            return self.tf.world_pose(&frame, &params.world_frame).ok_or_else(|| format!("its /tf frame '{frame}' does not reach world_frame yet"));
+        }
         let q = (0..robot.joints.len()).map(|j| self.left_out_position(j, "the message")).collect::<Result<Vec<f64>, String>>()?;
-        let poses = robot.forward_kinematics(&q, self.checker.base_pose()).map_err(|e| e.to_string())?;
-        Ok(poses.iter().map(pose_from_isometry).collect())
+        let poses = robot.forward_kinematics(&q, checker.base_pose()).map_err(|e| e.to_string())?;
+        poses.get(li).map(pose_from_isometry).ok_or_else(|| format!("no pose for link {li}"))
     }
 }

@@ -42,11 +42,11 @@ pub(crate) struct AttachedObject {
 }
 
 /// What the frames of a message are resolved against besides the scene: the checker (world
-/// frame, environment links, robot links) and the robot's link poses at the node's current merged
-/// joint state (computed when a message names a robot link).
+/// frame, environment links, robot links) and the pose of a robot link (by index) in the robot's
+/// current state (computed when a message names a robot link).
 pub(super) struct FrameContext<'a> {
     pub checker: &'a Checker,
-    pub robot_links: &'a dyn Fn() -> Result<Vec<Pose>, String>,
+    pub robot_link: &'a dyn Fn(usize) -> Result<Pose, String>,
 }
 
 fn refuse(cause: SkipCause, message: String) -> Skip {
@@ -86,9 +86,8 @@ impl SceneState {
             return Ok(p);
         }
         if let Some(li) = ctx.checker.robot().link(name) {
-            let poses = (ctx.robot_links)()
-                .map_err(|e| refuse(SkipCause::SceneFrame, format!("collision object '{id}': header.frame_id '{frame}' is a robot link, but {e}")))?;
-            return poses.get(li).copied().ok_or_else(|| refuse(SkipCause::SceneFrame, format!("collision object '{id}': no pose for link '{name}'")));
+            return (ctx.robot_link)(li)
+                .map_err(|e| refuse(SkipCause::SceneFrame, format!("collision object '{id}': header.frame_id '{frame}' is a robot link, but {e}")));
         }
         Err(refuse(
             SkipCause::SceneFrame,

@@ -69,7 +69,7 @@ pub struct Pipeline {
     pub(super) checker: Arc<Checker>,
     source: RobotSource,
     joints: JointInput,
-    tf: TfTree,
+    pub(super) tf: TfTree,
     skipped: BTreeMap<SkipCause, u64>,
     unknown_names: HashSet<String>,
     pub(super) warnings: Vec<String>,

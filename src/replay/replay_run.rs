@@ -394,10 +394,14 @@ fn decode<T: serde::de::DeserializeOwned>(pipeline: &mut Pipeline, m: &BagMessag
 }
 
 /// A planning-scene message (MoveIt's topics in the root namespace, as the node subscribes them
-/// there), applied at its log time as the node applies it on arrival: `None` for another topic,
+/// there), applied at its log time as the node applies it on arrival (with the parameter
+/// `planning_scene`, as the node subscribes them): `None` for another topic,
 /// else whether it was applied (an undecodable one is counted and warned about, and `Ok`).
 fn apply_scene_message(pipeline: &mut Pipeline, m: &BagMessage, warnings: &mut FirstWarnings) -> Option<Result<(), Skip>> {
     use crate::msgs::planning_scene::{AttachedCollisionObject, CollisionObject, PlanningScene, PlanningSceneWorld};
+    if !pipeline.params().planning_scene {
+        return None;
+    }
     let result = match m.topic.as_str() {
         "/collision_object" => decode::<CollisionObject>(pipeline, m, warnings).map(|o| pipeline.collision_object(&o)),
         "/attached_collision_object" => decode::<AttachedCollisionObject>(pipeline, m, warnings).map(|o| pipeline.attached_collision_object(&o)),
