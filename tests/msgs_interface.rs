@@ -27,7 +27,7 @@ fn msg_and_srv_files_parse_with_rosbags() {
     // Constants (`uint8 ROBOT_LINK=1`) are not fields.
     let fields: Vec<&str> =
         contact.lines().filter_map(|l| l.split('#').next()).filter_map(|l| l.split_whitespace().nth(1)).filter(|f| !f.contains('=')).collect();
-    assert_eq!(fields, ["link_name", "object_name", "triangle", "depth", "position", "normal", "object_type"]);
+    assert_eq!(fields, ["link_name", "object_name", "triangle", "depth", "position", "normal", "object_type", "link_type"]);
     let report = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/interfaces/thickness_collision_msgs/msg/CollisionReport.msg")).unwrap();
     let fields: Vec<&str> = report.lines().filter_map(|l| l.split('#').next()).filter_map(|l| l.split_whitespace().nth(1)).collect();
     assert_eq!(fields, ["header", "in_collision", "contacts", "check_seconds", "error", "motion", "fraction", "clearances"]);

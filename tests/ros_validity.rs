@@ -3,7 +3,7 @@
 //! `tests/peers/validity_peer.py`, types from this project's field lists in
 //! `tests/peers/moveit_types.py`, Cyclone's request/reply mapping), with the service name unchanged.
 //! `valid` and the contacts agree with `check --states FILE --json` on the same states; requests
-//! with an attached object, with constraints, with a multi-DOF joint, with a NaN joint and with an
+//! with an object attached to no link, with constraints, with a multi-DOF joint, with a NaN joint and with an
 //! unknown joint are answered `valid = false` without contacts, the reason in the node's log and
 //! counted in `/diagnostics`, and the node keeps answering after them. Loopback only, as in
 //! `tests/ros_node.rs`.
@@ -28,9 +28,19 @@ fn assert_same(k: usize, got: &Value, cli: &Value) {
     let (gc, cc) = (got["contacts"].as_array().unwrap(), cli["contacts"].as_array().unwrap());
     assert_eq!(gc.len(), cc.len(), "state {k}: {got} vs {cli}");
     for (g, c) in gc.iter().zip(cc) {
-        // ROBOT_LINK 0, WORLD_OBJECT 1: a self contact's object is another link.
-        let type_2 = if c["object_type"] == "robot_link" { json!(0) } else { json!(1) };
-        assert_eq!((&g["body_1"], &g["type_1"], &g["body_2"], &g["type_2"]), (&c["link_name"], &json!(0), &c["object_name"], &type_2), "state {k}");
+        // ROBOT_LINK 0, WORLD_OBJECT 1, ROBOT_ATTACHED 2: a self contact's object is another link
+        // or an attached object.
+        let code = |t: &Value| match t.as_str() {
+            Some("robot_link") => json!(0),
+            Some("attached_object") => json!(2),
+            _ => json!(1),
+        };
+        let type_1 = if c["link_type"] == "attached_object" { json!(2) } else { json!(0) };
+        assert_eq!(
+            (&g["body_1"], &g["type_1"], &g["body_2"], &g["type_2"]),
+            (&c["link_name"], &type_1, &c["object_name"], &code(&c["object_type"])),
+            "state {k}"
+        );
         assert!(
             common::close(&g["depth"], &c["depth"]) && common::close(&g["position"], &c["position"]) && common::close(&g["normal"], &c["normal"]),
             "state {k}: {g} vs {c}"
@@ -82,7 +92,8 @@ fn check_state_validity_agrees_with_check_and_refuses_what_it_cannot_honour() {
         )
         .collect();
     let bad = [
-        (json!({"name": names, "position": states[0], "attached": true}), "attached collision object"),
+        // The bare `true` attaches to the first joint's name, which is no link.
+        (json!({"name": names, "position": states[0], "attached": true}), "link_name: 'shoulder_pan_joint' is not a link of the robot"),
         (json!({"name": names, "position": states[0], "constraints": true}), "constraints given"),
         (json!({"name": names, "position": states[0], "multi_dof": ["virtual_joint"]}), "multi_dof_joint_state"),
         (json!({"name": ["elbow_joint"], "position": ["NaN"]}), "non-finite position NaN"),
@@ -124,4 +135,86 @@ fn check_state_validity_agrees_with_check_and_refuses_what_it_cannot_honour() {
     assert!(err.contains("group 'no_such_group' is not a group"), "an unknown group is warned about: {err}");
     assert!(answer["refused_count"].as_u64().is_some_and(|n| n >= bad.len() as u64), "/diagnostics counts the requests not honoured: {answer}");
     assert!(!err.contains("panicked"), "{err}");
+}
+
+/// An object attached to `tool0` in the request (`is_diff` false: the request's attached objects
+/// are all there are), with the gripper's links as touch links: the answers equal `check --json`
+/// on the twin robot, the same arm with a fixed child link `tray` of `tool0` and an SRDF that
+/// disables the tray's pairs with the touch links; the tray's contacts have `ROBOT_ATTACHED` body
+/// types.
+#[test]
+fn check_state_validity_with_an_attached_object_agrees_with_its_twin() {
+    use std::fmt::Write as _;
+    let dir = common::scratch_dir("ros_validity_attached");
+    let cyclone = common::cyclone_loopback_file(&dir);
+    let plain = Checker::from_params(Params::default()).unwrap();
+    // One matrix for both sides: an SRDF disabling what the default reasoning allows.
+    let targets = plain.targets();
+    let mut srdf = String::from("<robot name=\"tc_arm\">");
+    for a in 0..targets.len() {
+        for b in a + 1..targets.len() {
+            if !plain.self_pairs().pairs.contains(&(a, b)) {
+                let _ = write!(srdf, "<disable_collisions link1=\"{}\" link2=\"{}\" reason=\"Default\"/>", targets[a].name, targets[b].name);
+            }
+        }
+    }
+    let touch = ["gripper_link", "finger_left_link", "finger_right_link"];
+    let twin_srdf = touch.iter().fold(srdf.clone(), |s, l| s + &format!("<disable_collisions link1=\"tray\" link2=\"{l}\" reason=\"Touch\"/>")) + "</robot>";
+    let (srdf_file, twin_srdf_file, twin_urdf) = (dir.join("arm.srdf"), dir.join("twin.srdf"), dir.join("twin.urdf"));
+    std::fs::write(&srdf_file, srdf + "</robot>").unwrap();
+    std::fs::write(&twin_srdf_file, twin_srdf).unwrap();
+    let config = thickness_collision::model::bundled_config_dir();
+    let tray = "<link name=\"tray\"><collision><origin xyz=\"0 0 0.12\"/><geometry><box size=\"0.3 0.2 0.04\"/></geometry></collision></link><joint name=\"tray_joint\" type=\"fixed\"><parent link=\"tool0\"/><child link=\"tray\"/></joint></robot>";
+    let urdf = std::fs::read_to_string(config.join("example_workcell/robot.urdf"))
+        .unwrap()
+        .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", config.join("example_workcell/gripper.obj").display()))
+        .replacen("</robot>", tray, 1);
+    std::fs::write(&twin_urdf, urdf).unwrap();
+
+    let joints: Vec<_> = plain.robot().joints.iter().filter(|j| j.is_actuated()).collect();
+    let names: Vec<String> = joints.iter().map(|j| j.name.clone()).collect();
+    let mut rng = Rand64::new(34);
+    let states: Vec<Vec<f64>> = (0..40)
+        .map(|_| {
+            joints
+                .iter()
+                .map(|j| {
+                    let (lo, hi) = if j.kind == JointKind::Continuous { (-3.1, 3.1) } else { (j.limits[0], j.limits[1]) };
+                    lo + (hi - lo) * rng.rand_float()
+                })
+                .collect()
+        })
+        .collect();
+    let lines: Vec<Value> = states.iter().map(|p| json!({"name": names, "position": p})).collect();
+    let cli = common::check_json(&dir, "twin", &lines, &["--robot", twin_urdf.to_str().unwrap(), "--srdf", twin_srdf_file.to_str().unwrap()]);
+    let with_tray = cli.iter().filter(|r| r["contacts"].as_array().unwrap().iter().any(|c| c["link_name"] == "tray" || c["object_name"] == "tray")).count();
+    assert!(with_tray >= 5, "{with_tray} of {} states touch the tray: the test needs them", states.len());
+
+    let spec = json!({"link": "tool0", "id": "tray", "size": [0.3, 0.2, 0.04], "z": 0.12, "touch_links": touch});
+    let requests: Vec<Value> = states.iter().map(|q| json!({"name": names, "position": q, "attached": spec})).collect();
+    let domain = 220 + std::process::id() % 8;
+    let semantic = format!("robot_semantic_file:={}", srdf_file.display());
+    let (node, _out, _banner) = start_node(&["--ros-args", "-p", "check_motion:=false", "-p", &semantic], domain);
+    let answer = common::run_cyclone_peer("validity_peer.py", &cyclone, &json!({"domain": domain, "requests": requests, "timeout": 90}).to_string());
+    let err = common::stop_node(node);
+    let answers = answer["answers"].as_array().unwrap();
+    assert_eq!(answers.len(), requests.len());
+    let mut tray_types = 0;
+    for (k, (got, want)) in answers.iter().zip(&cli).enumerate() {
+        assert!(got.is_object(), "state {k} answered: {err}");
+        // The twin's tray is a robot link; the node's is an attached object.
+        let mut want = want.clone();
+        for c in want["contacts"].as_array_mut().unwrap() {
+            if c["link_name"] == "tray" {
+                c["link_type"] = json!("attached_object");
+            }
+            if c["object_name"] == "tray" {
+                c["object_type"] = json!("attached_object");
+            }
+        }
+        assert_same(k, got, &want);
+        tray_types += got["contacts"].as_array().unwrap().iter().filter(|c| c["type_1"] == 2 || c["type_2"] == 2).count();
+    }
+    assert!(tray_types >= 5, "ROBOT_ATTACHED contacts: {tray_types}");
+    assert!(!err.contains("panicked") && !err.contains("not honoured"), "{err}");
 }

@@ -3,6 +3,7 @@
 use super::checker::{BuildSummary, Checker};
 use super::checker_build::{allowed_matrix, moving_joints};
 use super::checker_error::CheckerError;
+use super::collision_matrix::CollisionMatrix;
 use super::link_targets::LinkTargets;
 use super::world_shapes::{add_world_object, attached_part, BodyCache, WorldShape};
 use crate::collision::Scene;
@@ -34,15 +35,17 @@ impl Checker {
         objects: impl IntoIterator<Item = (&'a str, &'a Pose, &'a [(WorldShape, Pose)])>,
         cache: &mut BodyCache,
     ) -> Result<Checker, CheckerError> {
-        self.with_scene(objects, &[], cache)
+        self.with_scene(objects, &[], None, cache)
     }
 
     /// [`Checker::with_world`], with `attached` objects on the robot's links (those of an earlier
-    /// call replaced).
+    /// call replaced), and the planning scene's allowed collision `matrix` in place of the SRDF's
+    /// (see [`Checker::with_targets`]).
     pub(crate) fn with_scene<'a>(
         &self,
         objects: impl IntoIterator<Item = (&'a str, &'a Pose, &'a [(WorldShape, Pose)])>,
         attached: &[Attached],
+        matrix: Option<&CollisionMatrix>,
         cache: &mut BodyCache,
     ) -> Result<Checker, CheckerError> {
         let environment = &self.scene.objects()[..self.environment_objects];
@@ -59,26 +62,47 @@ impl Checker {
         }
         cache.keep_used();
         let scene = self.scene.prefix_with(self.environment_objects, &added);
-        self.with_targets(Arc::new(scene), attached)
+        self.with_targets(Arc::new(scene), attached, matrix)
     }
 
     /// This checker with `attached` objects on the robot's links in place of its own (a
-    /// `check_state_validity` request's), the scene kept.
-    pub(crate) fn with_attached(&self, attached: &[Attached]) -> Result<Checker, CheckerError> {
-        self.with_targets(Arc::clone(&self.scene), attached)
+    /// `check_state_validity` request's), the scene and `matrix` kept.
+    pub(crate) fn with_attached(&self, attached: &[Attached], matrix: Option<&CollisionMatrix>) -> Result<Checker, CheckerError> {
+        self.with_targets(Arc::clone(&self.scene), attached, matrix)
     }
 
-    fn with_targets(&self, scene: Arc<Scene>, attached: &[Attached]) -> Result<Checker, CheckerError> {
+    /// The targets of the robot's links and of `attached`, against `scene`. Without a `matrix`
+    /// the robot's pairs are the SRDF's (or the default reasoning's); with one, every pair it
+    /// does not allow is checked, and a link and an object it allows are not. `allowed_collisions`
+    /// allows on top of either; an attached object never meets its own link or touch links.
+    fn with_targets(&self, scene: Arc<Scene>, attached: &[Attached], matrix: Option<&CollisionMatrix>) -> Result<Checker, CheckerError> {
         let mut targets = self.targets[..self.robot_targets].to_vec();
         for a in attached {
             targets.extend(self.attached_target(a)?);
         }
-        let allowed = allowed_matrix(&self.params, &targets, &scene);
+        let mut allowed = allowed_matrix(&self.params, &targets, &scene);
         let mut pairs = self.self_pairs.clone();
         pairs.pairs.retain(|&(_, b)| b < self.robot_targets);
+        if let Some(m) = matrix {
+            for (row, t) in allowed.iter_mut().zip(&targets) {
+                for (cell, o) in row.iter_mut().zip(scene.objects()) {
+                    *cell |= m.allows(&t.name, &o.name);
+                }
+            }
+            let both = |a: &str, b: &str| self.params.is_allowed(a, b) || self.params.is_allowed(b, a) || m.allows(a, b);
+            pairs.pairs = (0..self.robot_targets)
+                .flat_map(|a| (a + 1..self.robot_targets).map(move |b| (a, b)))
+                .filter(|&(a, b)| !both(&targets[a].name, &targets[b].name))
+                .collect();
+        }
         if self.params.self_collision {
-            pairs.pairs.extend(attached_pairs(&self.params, &targets, self.robot_targets, attached));
+            let pass = |a: &str, b: &str| matrix.is_none_or(|m| !m.allows(a, b));
+            pairs.pairs.extend(
+                attached_pairs(&self.params, &targets, self.robot_targets, attached).into_iter().filter(|&(a, b)| pass(&targets[a].name, &targets[b].name)),
+            );
             pairs.pairs.sort_unstable();
+        } else {
+            pairs.pairs.clear();
         }
         let mut checker = self.rebuilt(scene, allowed, pairs);
         if targets.len() != self.robot_targets || self.targets.len() != self.robot_targets {
@@ -109,6 +133,35 @@ impl Checker {
             .map(|(k, (shape, pose))| attached_part(shape, padding).map(|s| (s, *pose)).ok_or_else(|| refuse(format!("shape {k}: not a usable convex shape"))))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Some(LinkTargets { link, name: a.id.to_owned(), parts }))
+    }
+}
+
+impl Checker {
+    /// The allowed collision matrix in force as names and rows: the checked links and attached
+    /// objects, then the scene's objects (each name once); a pair of targets is allowed when it
+    /// is not checked, a target and an object when none of the object's shapes is checked
+    /// against it; two objects are never checked against each other.
+    pub(crate) fn collision_matrix_in_force(&self) -> (Vec<String>, Vec<Vec<bool>>) {
+        let mut names: Vec<String> = self.targets.iter().map(|t| t.name.clone()).collect();
+        let objects = self.scene.objects();
+        for o in objects {
+            if !names.contains(&o.name) {
+                names.push(o.name.clone());
+            }
+        }
+        let n = self.targets.len();
+        let mut rows = vec![vec![true; names.len()]; names.len()];
+        for a in 0..n {
+            for b in 0..n {
+                rows[a][b] = a == b || !self.self_pairs.pairs.contains(&(a.min(b), a.max(b)));
+            }
+            for (k, name) in names.iter().enumerate().skip(n) {
+                let checked = objects.iter().enumerate().any(|(oi, o)| o.name == *name && !self.allowed[a][oi]);
+                rows[a][k] = !checked;
+                rows[k][a] = !checked;
+            }
+        }
+        (names, rows)
     }
 }
 

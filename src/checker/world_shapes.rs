@@ -37,6 +37,32 @@ pub(crate) enum WorldShape {
     /// Triangles whose front is the side their vertices wind counter-clockwise around (shared:
     /// a moved object keeps its mesh, and the cells built for it).
     Mesh(Arc<MeshData>),
+    /// `shape_msgs/Plane`: the points `x` with `a x + b y + c z + d = 0`, its front the side
+    /// `(a, b, c)` points to; a thin surface without an edge near the robot (see [`plane_mesh`]).
+    Plane([f64; 4]),
+}
+
+/// Half the side of the square that stands for an infinite plane (metres): 10 km, so every
+/// point a robot reaches within 1e4 m of the plane's foot point sees no edge, while the cells'
+/// arithmetic keeps its precision (1e4 m x 1e-16).
+pub(crate) const PLANE_HALF_SIDE: f64 = 1e4;
+
+/// A plane as two triangles winding counter-clockwise around its normal: the square of
+/// [`PLANE_HALF_SIDE`] centred on the plane's point nearest the shape's origin. `None` for a
+/// normal that is zero or not finite.
+pub(crate) fn plane_mesh(coef: &[f64; 4]) -> Option<MeshData> {
+    let n = Vector::new(coef[0], coef[1], coef[2]);
+    let len = n.length();
+    if !(len.is_finite() && len > 1e-12 && coef[3].is_finite()) {
+        return None;
+    }
+    let n = n / len;
+    let foot = -n * (coef[3] / len);
+    let u = n.any_orthonormal_vector();
+    let v = n.cross(u);
+    let h = PLANE_HALF_SIDE;
+    let vertices = vec![foot - u * h - v * h, foot + u * h - v * h, foot + u * h + v * h, foot - u * h + v * h];
+    Some(MeshData { vertices, triangles: vec![[0, 1, 2], [0, 2, 3]] })
 }
 
 /// Corners of the polygon around a cone's base: circumscribed, so that the hull holds the cone
@@ -99,6 +125,18 @@ impl BodyCache {
     }
 }
 
+/// A plane's body: the cells of [`plane_mesh`], with the thickness and side of the object's id,
+/// each cell's triangle `u32::MAX` (a plane has no triangles of its own).
+fn plane_body(params: &Params, id: &str, coef: &[f64; 4], summary: &mut BuildSummary) -> Option<ObjectBody> {
+    let mut body = environment_mesh_body(params, id, &plane_mesh(coef)?, summary).ok()?;
+    if let ObjectBody::Surface { area, .. } = &mut body {
+        for cell in &mut area.cells {
+            cell.triangle = u32::MAX;
+        }
+    }
+    Some(body)
+}
+
 /// A body found in the cache counts in the summary as if it had been built.
 fn count(body: &ObjectBody, summary: &mut BuildSummary) {
     match body {
@@ -146,6 +184,11 @@ pub(crate) fn add_world_object(
             let _ = scene.add_body(id.to_owned(), pose, body);
             continue;
         }
+        if let WorldShape::Plane(coef) = shape {
+            let body = plane_body(params, id, coef, summary).ok_or_else(|| format!("shape {k} (a plane): not a plane (its normal is zero or not finite)"))?;
+            let _ = scene.add_body(id.to_owned(), pose, Arc::new(body));
+            continue;
+        }
         let solid = solid(shape).ok_or_else(|| format!("shape {k} ({shape_kind}): not a usable convex shape", shape_kind = kind(shape)))?;
         let _ = scene.add_solid(id.to_owned(), pose, solid);
         summary.solids += 1;
@@ -161,6 +204,7 @@ fn kind(shape: &WorldShape) -> &'static str {
         WorldShape::Cone { .. } => "a cone",
         WorldShape::Prism { .. } => "a prism",
         WorldShape::Mesh(_) => "a mesh",
+        WorldShape::Plane(_) => "a plane",
     }
 }
 
@@ -173,6 +217,7 @@ pub(crate) fn attached_part(shape: &WorldShape, padding: f64) -> Option<TargetSh
         WorldShape::Sphere(r) => primitive_shape(&GeometrySpec::Sphere(*r), padding),
         WorldShape::Cylinder { height, radius } => primitive_shape(&GeometrySpec::Cylinder { radius: *radius, length: *height }, padding),
         WorldShape::Mesh(m) => grown(ConvexHull::from_points(&m.vertices)),
+        WorldShape::Plane(_) => None,
         WorldShape::Cone { .. } | WorldShape::Prism { .. } => match solid(shape)? {
             TargetShape::Polytope(h) => grown(Some((*h).clone())),
             _ => None,
@@ -208,7 +253,7 @@ fn solid(shape: &WorldShape) -> Option<TargetShape> {
             }
             hull(polygon.iter().flat_map(|[x, y]| [Vector::new(*x, *y, -height / 2.0), Vector::new(*x, *y, height / 2.0)]).collect())
         }
-        WorldShape::Mesh(_) => None,
+        WorldShape::Mesh(_) | WorldShape::Plane(_) => None,
     }
 }
 

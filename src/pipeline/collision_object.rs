@@ -44,9 +44,6 @@ pub(crate) fn object_to_add(msg: &CollisionObject, header: Pose) -> Result<AddOb
             return Err(format!("collision object '{id}': {what}: {poses} poses for {shapes} shapes (at most one pose per shape)"));
         }
     }
-    if !msg.planes.is_empty() {
-        return Err(format!("collision object '{id}': planes: not supported yet (an infinite plane has no cells here)"));
-    }
     if msg.subframe_names.len() != msg.subframe_poses.len() {
         return Err(format!(
             "collision object '{id}': {} subframe_names for {} subframe_poses (one pose per name)",
@@ -66,6 +63,14 @@ pub(crate) fn object_to_add(msg: &CollisionObject, header: Pose) -> Result<AddOb
             return Err(format!("collision object '{id}': meshes: more than {MAX_OBJECT_TRIANGLES} triangles"));
         }
         shapes.push((mesh(m, id, k)?, shape_pose(&msg.mesh_poses, k, "mesh_poses")?));
+    }
+    for (k, p) in msg.planes.iter().enumerate() {
+        let c = p.coef;
+        let normal = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        if !(c.iter().all(|x| x.is_finite()) && normal > 1e-12 && (c[3] / normal).abs() <= 1e5) {
+            return Err(format!("collision object '{id}': planes[{k}].coef: {c:?} is not a plane (a finite non-zero normal, the plane within 1e5 m)"));
+        }
+        shapes.push((WorldShape::Plane(c), shape_pose(&msg.plane_poses, k, "plane_poses")?));
     }
     let pose = if is_empty(&msg.pose) { None } else { Some(pose_of(&msg.pose, id, "pose")?) };
     let subframes = msg
@@ -91,7 +96,7 @@ fn primitive(p: &SolidPrimitive, id: &str, k: usize) -> Result<WorldShape, Strin
     // below 1e-6 m a shape is degenerate.
     let [lo, hi] = crate::limits::LENGTH_RANGE;
     if let Some((i, v)) = d.iter().enumerate().find(|(_, v)| !(lo..=hi).contains(*v)) {
-        return Err(format!("collision object '{id}': primitives[{k}].dimensions[{i}]: {v} is not a size from {lo} to {hi} m"));
+        return Err(format!("collision object '{id}': primitives[{k}].dimensions[{i}]: {v:?} is not a size from {lo:e} to {hi:e} m"));
     }
     let shape = match p.kind {
         SolidPrimitive::BOX => need(3, "box").map(|_| WorldShape::Box([d[0], d[1], d[2]])),
@@ -192,10 +197,13 @@ mod tests {
                 CollisionObject { primitives: vec![primitive(SolidPrimitive::SPHERE, &[1e154])], ..base.clone() },
                 "primitives[0].dimensions[0]: 1e154 is not a size",
             ),
-            (CollisionObject { primitives: vec![primitive(SolidPrimitive::BOX, &[0.1, 0.0, 0.1])], ..base.clone() }, "dimensions[1]: 0 is not a size"),
+            (
+                CollisionObject { primitives: vec![primitive(SolidPrimitive::BOX, &[0.1, 0.0, 0.1])], ..base.clone() },
+                "dimensions[1]: 0.0 is not a size from 1e-6 to 1e4 m",
+            ),
             (CollisionObject { primitives: vec![primitive(SolidPrimitive::PRISM, &[0.1])], ..base.clone() }, "a prism's polygon needs 3 points"),
             (CollisionObject { primitive_poses: vec![pose(0.0)], ..base.clone() }, "primitive_poses: 1 poses for 0 shapes"),
-            (CollisionObject { planes: vec![Default::default()], ..base.clone() }, "planes: not supported yet"),
+            (CollisionObject { planes: vec![Default::default()], ..base.clone() }, "planes[0].coef: [0.0, 0.0, 0.0, 0.0] is not a plane"),
             (
                 CollisionObject { meshes: vec![ShapeMesh { triangles: vec![MeshTriangle { vertex_indices: [0, 1, 7] }], ..sheet() }], ..base.clone() },
                 "meshes[0].triangles[0]: vertex index 7 of 3 vertices",

@@ -65,7 +65,10 @@ impl Pipeline {
         for a in &state.attached_collision_objects {
             scene.apply_attached(&ctx, a).map_err(|s| format!("robot_state.attached_collision_objects: {}", s.message))?;
         }
-        self.checker.with_attached(&scene.attached_specs()).map(Arc::new).map_err(|e| format!("robot_state.attached_collision_objects: {e}"))
+        self.checker
+            .with_attached(&scene.attached_specs(), scene.matrix.as_ref())
+            .map(Arc::new)
+            .map_err(|e| format!("robot_state.attached_collision_objects: {e}"))
     }
 
     /// Planning-scene objects in force: in the world, and attached to the robot.
@@ -95,7 +98,9 @@ impl Pipeline {
         let result = change(&mut next, &FrameContext { checker: &self.checker, robot_link: &robot_link }).and_then(|()| {
             let objects = next.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
             let attached = next.attached_specs();
-            self.checker.with_scene(objects, &attached, &mut self.bodies).map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() })
+            self.checker
+                .with_scene(objects, &attached, next.matrix.as_ref(), &mut self.bodies)
+                .map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() })
         });
         match result {
             Ok(checker) => {

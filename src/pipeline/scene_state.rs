@@ -9,11 +9,11 @@
 use super::collision_object::{object_to_add, pose_of, MAX_OBJECT_TRIANGLES};
 use super::planning_world::{PlanningWorld, WorldError};
 use super::skip::{Skip, SkipCause};
-use crate::checker::{Attached, Checker, WorldShape};
+use crate::checker::{Attached, Checker, CollisionMatrix, WorldShape};
 use crate::math::Pose;
 use crate::msgs::planning_scene::{
-    AttachedCollisionObject, CollisionObject, MeshTriangle, PlanningScene, PlanningSceneComponents, PlanningSceneWorld, Point32, Polygon, ShapeMesh,
-    SolidPrimitive, MAX_SCENE_OBJECTS,
+    AllowedCollisionEntry, AllowedCollisionMatrix, AttachedCollisionObject, CollisionObject, MeshTriangle, Plane, PlanningScene, PlanningSceneComponents,
+    PlanningSceneWorld, Point32, Polygon, ShapeMesh, SolidPrimitive, MAX_SCENE_OBJECTS,
 };
 use crate::msgs::{Header, Point, PoseMsg, Quaternion, Time, Transform, TransformStamped, Vector3};
 use std::collections::BTreeMap;
@@ -30,6 +30,8 @@ pub(crate) struct SceneState {
     pub(super) attached: BTreeMap<String, AttachedObject>,
     /// `fixed_frame_transforms`: frames objects may be given in, by name, posed in the world.
     pub(super) fixed_frames: BTreeMap<String, Pose>,
+    /// The allowed collision matrix a scene message gave, in place of the SRDF's.
+    pub(super) matrix: Option<CollisionMatrix>,
 }
 
 /// An object attached to a robot link: it moves with the link.
@@ -181,23 +183,23 @@ impl SceneState {
         msg.collision_objects.iter().try_for_each(|o| self.apply_object(ctx, o))
     }
 
-    /// A `PlanningScene`, a difference (`is_diff`) or the whole scene, in MoveIt's order: fixed
-    /// frames, the robot state's attached objects (all replaced when `robot_state.is_diff` is
-    /// false), world objects. What it holds that is not supported yet refuses it whole (allowed
-    /// collision entries, link padding or scale: ignoring them would check against a scene the
-    /// planner does not have). The robot state's joint positions are not used: states come from
+    /// A `PlanningScene`, a difference (`is_diff`) or the whole scene, in MoveIt's order: the
+    /// allowed collision matrix (one with entries replaces the one in force), fixed frames, the
+    /// robot state's attached objects (all replaced when `robot_state.is_diff` is false), world
+    /// objects. What it holds that is not supported yet refuses it whole (link padding or scale:
+    /// ignoring them would check against a scene the planner does not have). The robot state's joint positions are not used: states come from
     /// `joint_states`.
     pub(super) fn apply_scene(&mut self, ctx: &FrameContext, msg: &PlanningScene) -> Result<(), Skip> {
-        let unsupported = [
-            (!msg.allowed_collision_matrix.entry_names.is_empty() || !msg.allowed_collision_matrix.default_entry_names.is_empty(), "allowed_collision_matrix"),
-            (!msg.link_padding.is_empty(), "link_padding"),
-            (!msg.link_scale.is_empty(), "link_scale"),
-        ];
+        let unsupported = [(!msg.link_padding.is_empty(), "link_padding"), (!msg.link_scale.is_empty(), "link_scale")];
         if let Some((_, field)) = unsupported.iter().find(|(given, _)| *given) {
             return Err(refuse(SkipCause::SceneUnsupported, format!("planning scene: {field}: not supported yet; the scene is left as it was")));
         }
         if !msg.is_diff {
             *self = SceneState::default();
+        }
+        let acm = &msg.allowed_collision_matrix;
+        if !acm.entry_names.is_empty() || !acm.default_entry_names.is_empty() {
+            self.matrix = Some(matrix_of(acm)?);
         }
         let world = &ctx.checker.params().world_frame;
         for (k, t) in msg.fixed_frame_transforms.iter().enumerate() {
@@ -259,6 +261,15 @@ impl SceneState {
                 })
                 .collect();
         }
+        if components & PlanningSceneComponents::ALLOWED_COLLISION_MATRIX != 0 {
+            scene.allowed_collision_matrix = match &self.matrix {
+                Some(m) => matrix_message(m.parts()),
+                None => {
+                    let (names, rows) = checker.collision_matrix_in_force();
+                    matrix_message((&names, &rows, &BTreeMap::new()))
+                }
+            };
+        }
         if components & PlanningSceneComponents::TRANSFORMS != 0 {
             scene.fixed_frame_transforms = self
                 .fixed_frames
@@ -267,6 +278,30 @@ impl SceneState {
                 .collect();
         }
         scene
+    }
+}
+
+/// The message's matrix, or why it cannot be read.
+fn matrix_of(acm: &AllowedCollisionMatrix) -> Result<CollisionMatrix, Skip> {
+    if acm.default_entry_names.len() != acm.default_entry_values.len() {
+        let (n, v) = (acm.default_entry_names.len(), acm.default_entry_values.len());
+        return Err(refuse(
+            SkipCause::SceneGeometry,
+            format!("planning scene: allowed_collision_matrix: {n} default_entry_names but {v} default_entry_values"),
+        ));
+    }
+    let rows = acm.entry_values.iter().map(|r| r.enabled.clone()).collect();
+    let defaults = acm.default_entry_names.iter().cloned().zip(acm.default_entry_values.iter().copied()).collect();
+    CollisionMatrix::new(acm.entry_names.clone(), rows, defaults)
+        .map_err(|e| refuse(SkipCause::SceneGeometry, format!("planning scene: allowed_collision_matrix: {e}")))
+}
+
+fn matrix_message((names, rows, defaults): (&[String], &[Vec<bool>], &BTreeMap<String, bool>)) -> AllowedCollisionMatrix {
+    AllowedCollisionMatrix {
+        entry_names: names.to_vec(),
+        entry_values: rows.iter().map(|r| AllowedCollisionEntry { enabled: r.clone() }).collect(),
+        default_entry_names: defaults.keys().cloned().collect(),
+        default_entry_values: defaults.values().copied().collect(),
     }
 }
 
@@ -308,6 +343,11 @@ fn fill_shapes(msg: &mut CollisionObject, shapes: &[(WorldShape, Pose)]) {
                 dimensions: vec![*height],
                 polygon: Polygon { points: polygon.iter().map(|[x, y]| Point32 { x: *x as f32, y: *y as f32, z: 0.0 }).collect() },
             },
+            WorldShape::Plane(coef) => {
+                msg.planes.push(Plane { coef: *coef });
+                msg.plane_poses.push(pose_msg(pose));
+                continue;
+            }
             WorldShape::Mesh(m) => {
                 msg.meshes.push(ShapeMesh {
                     triangles: m.triangles.iter().map(|t| MeshTriangle { vertex_indices: *t }).collect(),

@@ -263,3 +263,79 @@ fn an_attached_object_is_checked_as_a_fixed_child_link() {
     let box_pose = world_tray.pose * world_tray.shapes[0].1;
     assert!((box_pose.translation - (tool * Pose::from_translation(Vector::new(0.0, 0.0, 0.12))).translation).length() < 1e-12);
 }
+
+/// A plane is checked as the two-triangle square of the same plane and thickness (here 10 m a
+/// side, its diagonal along the plane's own), its contacts with triangle `u32::MAX`.
+#[test]
+fn a_plane_is_a_thin_surface_without_an_edge() {
+    use crate::checker::StateReport;
+    use crate::msgs::planning_scene::Plane;
+    let coef = [-1.0, 0.0, 0.0, 0.45];
+    let mut p = Pipeline::new(Params::default()).unwrap();
+    p.collision_object(&CollisionObject { planes: vec![Plane { coef }], ..object("world", "wall", CollisionObject::ADD) }).unwrap();
+    let big = crate::checker::plane_mesh(&coef).unwrap();
+    let small = |v: crate::math::Vector| Vector::new(0.45, 0.0, 0.0) + (v - Vector::new(0.45, 0.0, 0.0)) * (5.0 / crate::checker::PLANE_HALF_SIDE);
+    let sheet = ShapeMesh {
+        vertices: big.vertices.iter().map(|v| small(*v)).map(|v| Point { x: v.x, y: v.y, z: v.z }).collect(),
+        triangles: big.triangles.iter().map(|t| MeshTriangle { vertex_indices: *t }).collect(),
+    };
+    let mut twin = Pipeline::new(Params::default()).unwrap();
+    twin.collision_object(&CollisionObject { meshes: vec![sheet], ..object("world", "wall", CollisionObject::ADD) }).unwrap();
+    let names: Vec<String> = ARM.iter().map(|s| s.to_string()).collect();
+    let mut rng = oorandom::Rand64::new(9);
+    let mut on_wall = 0;
+    for _ in 0..300 {
+        let q: Vec<f64> = ARM.iter().map(|_| -2.5 + 5.0 * rng.rand_float()).collect();
+        let (a, b) = (p.checker().check_joints(&names, &q).unwrap(), twin.checker().check_joints(&names, &q).unwrap());
+        // Bodies, depths and normals; not the points: where a link passes through the whole slab,
+        // any point of the overlap is a contact point, and the cells decide which one is given.
+        let without_triangles = |r: &StateReport| {
+            r.contacts
+                .iter()
+                .map(|c| (c.link_name.clone(), c.object_name.clone(), c.normal.map(|v| (v * 1e9).round()), (c.depth * 1e9).round()))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(without_triangles(&a), without_triangles(&b), "at {q:?}");
+        for c in a.contacts.iter().filter(|c| c.object_name == "wall") {
+            assert_eq!(c.triangle, u32::MAX);
+            on_wall += 1;
+        }
+    }
+    assert!(on_wall > 10, "{on_wall} contacts with the plane");
+    let msg = p.planning_scene_message(PlanningSceneComponents::WORLD_OBJECT_GEOMETRY, Time::default());
+    assert_eq!(msg.world.collision_objects[0].planes, [Plane { coef }], "get_planning_scene gives the plane back");
+}
+
+/// The allowed collision matrix: `get_planning_scene` gives the one in force (the default
+/// reasoning's pairs without an SRDF); written back it changes nothing; an entry that allows a
+/// link and an object silences that pair only; a new SRDF replaces it.
+#[test]
+fn the_allowed_collision_matrix_travels_and_applies() {
+    let mut p = Pipeline::new(Params::default()).unwrap();
+    p.collision_object(&sheet_at(0.2, -0.3, 0.3)).unwrap();
+    let before = reports(&p);
+    let acm = p.planning_scene_message(PlanningSceneComponents::ALLOWED_COLLISION_MATRIX, Time::default()).allowed_collision_matrix;
+    let pairs = p.checker().self_pairs().pairs.clone();
+    let diff = |acm| PlanningScene { is_diff: true, allowed_collision_matrix: acm, ..Default::default() };
+    p.planning_scene(&diff(acm.clone())).unwrap();
+    assert_eq!(p.checker().self_pairs().pairs, pairs, "the matrix written back checks the same pairs");
+    assert_eq!(reports(&p), before);
+    // Allow the sheet against the forearm.
+    let mut edited = acm.clone();
+    let (f, s) = (edited.entry_names.iter().position(|n| n == "forearm_link").unwrap(), edited.entry_names.iter().position(|n| n == "scan").unwrap());
+    edited.entry_values[f].enabled[s] = true;
+    edited.entry_values[s].enabled[f] = true;
+    p.planning_scene(&diff(edited)).unwrap();
+    let after = reports(&p);
+    assert!(after.iter().all(|(_, c)| !c.iter().any(|(l, o)| l == "forearm_link" && o == "scan")));
+    let changed = before.iter().zip(&after).filter(|(a, b)| a != b).count();
+    assert!(
+        changed > 0 && before.iter().zip(&after).all(|(a, b)| a == b || a.1.iter().any(|(l, o)| l == "forearm_link" && o == "scan")),
+        "only the allowed pair changes"
+    );
+    // A bad matrix is refused whole.
+    let mut bad = acm;
+    let _ = bad.entry_values.pop();
+    assert_eq!(p.planning_scene(&diff(bad)).unwrap_err().cause, SkipCause::SceneGeometry);
+    assert_eq!(reports(&p), after);
+}

@@ -420,6 +420,8 @@ impl Pipeline {
         self.semantic = Some((text.into(), source.to_owned()));
         self.semantic_deferred = false;
         let checker = crate::limits::contain_panic(|| self.checker.with_other_semantic(text, source)).map_err(CheckerError::Panicked)??;
+        // A new SRDF is the matrix from now on, in place of one a planning scene gave.
+        self.scene.matrix = None;
         self.replace(checker);
         Ok(())
     }
@@ -472,7 +474,7 @@ impl Pipeline {
             checker
         } else {
             let objects = self.scene.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
-            match checker.with_scene(objects, &self.scene.attached_specs(), &mut self.bodies) {
+            match checker.with_scene(objects, &self.scene.attached_specs(), self.scene.matrix.as_ref(), &mut self.bodies) {
                 Ok(with) => with,
                 Err(e) => {
                     let (world, attached) = (self.scene.world.len(), self.scene.attached.len());

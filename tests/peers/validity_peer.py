@@ -5,7 +5,7 @@ service name as move_group's tools use it (check_state_validity, under the node'
 Loopback only: the caller sets CYCLONEDDS_URI (127.0.0.1, no multicast, peer 127.0.0.1).
 
 stdin: {"domain": id, "requests": [R...], "timeout": s}
-        R = {"name": [...], "position": [... or "NaN"], "group": str (optional), "attached": bool,
+        R = {"name": [...], "position": [... or "NaN"], "group": str (optional), "attached": bool or a box (see attached_object),
              "constraints": bool, "multi_dof": [names] (optional), "is_diff": bool, "pause": s to wait before sending}
 stdout: {"answers": [A or null...], "refused_count": last /diagnostics check_state_validity_refused or null}
         A = {"valid", "contacts": [{"body_1", "type_1", "body_2", "type_2", "depth", "position", "normal", "frame"}],
@@ -42,13 +42,19 @@ def pose():
     return m.Pose(position=m.Point(x=0.0, y=0.0, z=0.0), orientation=m.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0))
 
 
-def attached_object(link):
-    box = m.SolidPrimitive(type=1, dimensions=[0.1, 0.1, 0.1], polygon=m.Polygon(points=[]))
-    obj = m.CollisionObject(header=header("world"), pose=pose(), id="held_box", type=m.ObjectType(key="", db=""), primitives=[box],
-                            primitive_poses=[pose()], meshes=[], mesh_poses=[], planes=[], plane_poses=[], subframe_names=[],
+def attached_object(link, spec=None):
+    """A box attached to `link`: 10 cm in the world frame at the origin, or as `spec` says
+    ({"link", "id", "size": [x, y, z], "z": offset along the link's z, "touch_links": [...]}, given in the link's frame)."""
+    spec = spec or {}
+    link = spec.get("link", link)
+    frame = link if spec else "world"
+    offset = m.Pose(position=m.Point(x=0.0, y=0.0, z=float(spec.get("z", 0.0))), orientation=m.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0))
+    box = m.SolidPrimitive(type=1, dimensions=[float(x) for x in spec.get("size", [0.1, 0.1, 0.1])], polygon=m.Polygon(points=[]))
+    obj = m.CollisionObject(header=header(frame), pose=pose(), id=spec.get("id", "held_box"), type=m.ObjectType(key="", db=""), primitives=[box],
+                            primitive_poses=[offset], meshes=[], mesh_poses=[], planes=[], plane_poses=[], subframe_names=[],
                             subframe_poses=[], operation=0)
     posture = m.JointTrajectory(header=header(), joint_names=[], points=[])
-    return m.AttachedCollisionObject(link_name=link, object=obj, touch_links=[link], detach_posture=posture, weight=0.0)
+    return m.AttachedCollisionObject(link_name=link, object=obj, touch_links=spec.get("touch_links", [link]), detach_posture=posture, weight=0.0)
 
 
 def request(r, seq):
@@ -56,7 +62,8 @@ def request(r, seq):
     multi = r.get("multi_dof", [])
     identity = m.Transform(translation=m.Vector3(x=0.0, y=0.0, z=0.0), rotation=m.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0))
     mdof = m.MultiDOFJointState(header=header(), joint_names=multi, transforms=[identity for _ in multi], twist=[], wrench=[])
-    attached = [attached_object(r["name"][0] if r.get("name") else "tool0")] if r.get("attached") else []
+    spec = r.get("attached")
+    attached = [attached_object(r["name"][0] if r.get("name") else "tool0", spec if isinstance(spec, dict) else None)] if spec else []
     state = m.RobotState(joint_state=js, multi_dof_joint_state=mdof, attached_collision_objects=attached, is_diff=bool(r.get("is_diff")))
     joint_constraints = [m.JointConstraint(joint_name=r["name"][0], position=0.0, tolerance_above=0.1, tolerance_below=0.1, weight=1.0)] \
         if r.get("constraints") else []
