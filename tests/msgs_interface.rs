@@ -59,7 +59,7 @@ fn msg_and_srv_files_parse_with_rosbags() {
     let c = thickness_collision::msgs::ContactMsg::default();
     let v = serde_json::to_value(&c).unwrap();
     let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
-    assert_eq!(keys.len(), 7);
+    assert_eq!(keys.len(), 8);
 }
 
 /// `CheckTrajectory.srv`'s two parts against the serde structs the node sends and receives (field
