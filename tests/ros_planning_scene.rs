@@ -153,6 +153,51 @@ struct Story {
     checkpoints: Vec<(&'static str, PathBuf, &'static str)>,
 }
 
+/// An SRDF for the bundled arm that disables exactly what the default reasoning allows (so the
+/// node with it checks what `check` without one does), and the same with the pairs of a fixed
+/// child link `tray` and each touch link disabled: (plain, with the tray).
+fn arm_srdfs(touch: &[&str]) -> (String, String) {
+    let plain = Checker::from_params(Params::default()).unwrap();
+    let targets = plain.targets();
+    let mut srdf = String::from("<robot name=\"tc_arm\">");
+    for a in 0..targets.len() {
+        for b in a + 1..targets.len() {
+            if !plain.self_pairs().pairs.contains(&(a, b)) {
+                let _ = write!(srdf, "<disable_collisions link1=\"{}\" link2=\"{}\" reason=\"Default\"/>", targets[a].name, targets[b].name);
+            }
+        }
+    }
+    let with_tray = touch.iter().fold(srdf.clone(), |s, l| s + &format!("<disable_collisions link1=\"tray\" link2=\"{l}\" reason=\"Touch\"/>"));
+    (srdf + "</robot>", with_tray + "</robot>")
+}
+
+/// The bundled arm holding a tray: a fixed child link `tray` of `tool0` (a 0.3 x 0.2 x 0.04 m box
+/// 0.12 m out along its z), as URDF text with absolute mesh paths.
+fn arm_with_tray() -> String {
+    let config = thickness_collision::model::bundled_config_dir();
+    let tray = "<link name=\"tray\"><collision><origin xyz=\"0 0 0.12\"/><geometry><box size=\"0.3 0.2 0.04\"/></geometry></collision></link><joint name=\"tray_joint\" type=\"fixed\"><parent link=\"tool0\"/><child link=\"tray\"/></joint></robot>";
+    std::fs::read_to_string(config.join("example_workcell/robot.urdf"))
+        .unwrap()
+        .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", config.join("example_workcell/gripper.obj").display()))
+        .replacen("</robot>", tray, 1)
+}
+
+/// `check`'s report for a world with a plane, as the node gives it: the plane's twin is a
+/// two-triangle sheet, so its contacts get the plane's triangle (`u32::MAX`); and its point is
+/// taken from the node's report (where a link passes through the whole slab any point of the
+/// overlap is a contact point, and the cells decide which one): bodies, depths and normals are
+/// compared.
+fn as_plane(want: &Value, got: &Value, plane: &str) -> Value {
+    let mut want = want.clone();
+    for (w, g) in want["contacts"].as_array_mut().unwrap().iter_mut().zip(got["contacts"].as_array().unwrap()) {
+        if w["object_name"] == plane {
+            w["triangle"] = json!(u32::MAX);
+            w["position"] = g["position"].clone();
+        }
+    }
+    want
+}
+
 #[test]
 fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
     let dir = common::scratch_dir("ros_planning_scene");
@@ -180,6 +225,18 @@ fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
         rpy: [0.0; 3],
         collisions: format!("{box_urdf}<collision><origin xyz=\"0 0.2 0.1\"/><geometry><sphere radius=\"0.08\"/></geometry></collision>"),
     };
+    // A plane x = 0.6875 facing the arm (exact in the single precision the twin's mesh file is
+    // read in), and its twin: the 10 x 10 m square of it with the diagonal
+    // the node's square has (its corners foot +- 5 u +- 5 v, u = (0, 1, 0), v = n x u = (0, 0, -1)).
+    let square = dir.join("wall_plane.obj");
+    std::fs::write(&square, "v 0.6875 -5 5\nv 0.6875 5 5\nv 0.6875 5 -5\nv 0.6875 -5 -5\nf 1 2 3\nf 1 3 4\n").unwrap();
+    let wall_link = TwinLink {
+        name: "wall_plane",
+        parent: "world",
+        xyz: [0.0; 3],
+        rpy: [0.0; 3],
+        collisions: format!("<collision><geometry><mesh filename=\"{}\"/></geometry></collision>", square.display()),
+    };
     // A box 0.15 m above the table's frame, given in the environment link `table`.
     let on_table = TwinLink {
         name: "on_table",
@@ -195,15 +252,34 @@ fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
             ("sheet moved", twin(&dir, "c", &[&sheet_link(sheet_moved), &crate_box]), "scan_sheet"),
             ("sphere appended to the crate, sheet removed", twin(&dir, "d", &[&crate_full]), "crate"),
             ("an object in the table's frame", twin(&dir, "e", &[&crate_full, &on_table]), "on_table"),
+            ("a plane", twin(&dir, "f", &[&crate_full, &on_table, &wall_link]), "wall_plane"),
+            ("a tray attached to the hand", twin(&dir, "g", &[&crate_full, &on_table, &wall_link]), "tray"),
+            ("the crate allowed by the collision matrix", twin(&dir, "h", &[&on_table, &wall_link]), "tray"),
         ],
     };
+    // The tray's twins are the arm holding it, with the SRDF that disables its touch links.
+    let touch = ["gripper_link", "finger_left_link", "finger_right_link"];
+    let (srdf, tray_srdf) = arm_srdfs(&touch);
+    let (srdf_file, tray_srdf_file, tray_urdf) = (dir.join("arm.srdf"), dir.join("tray.srdf"), dir.join("tray.urdf"));
+    std::fs::write(&srdf_file, srdf).unwrap();
+    std::fs::write(&tray_srdf_file, tray_srdf).unwrap();
+    std::fs::write(&tray_urdf, arm_with_tray()).unwrap();
+    let holding = ["--robot", tray_urdf.to_str().unwrap(), "--srdf", tray_srdf_file.to_str().unwrap()];
     let cli: Vec<Vec<Value>> = story
         .checkpoints
         .iter()
-        .map(|(label, env, _)| common::check_json(&dir, label.split(' ').next().unwrap(), &states, &["--environment", env.to_str().unwrap()]))
+        .enumerate()
+        .map(|(k, (_, env, _))| {
+            let mut args = vec!["--environment", env.to_str().unwrap()];
+            if k >= 6 {
+                args.extend(holding);
+            }
+            common::check_json(&dir, &format!("checkpoint{k}"), &states, &args)
+        })
         .collect();
     for ((label, _, object), reports) in story.checkpoints.iter().zip(&cli) {
-        let touching = reports.iter().filter(|r| r["contacts"].as_array().unwrap().iter().any(|c| c["object_name"] == *object)).count();
+        let touching =
+            reports.iter().filter(|r| r["contacts"].as_array().unwrap().iter().any(|c| c["object_name"] == *object || c["link_name"] == *object)).count();
         let colliding = reports.iter().filter(|r| r["in_collision"] == true).count();
         assert!(
             touching >= 2 && colliding < reports.len(),
@@ -264,22 +340,65 @@ fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
     steps.push(states_step());
     steps.push(json!({"get": 8 | 16 | 64}));
 
+    // Then a plane and a tray in the hand (topics), and the collision matrix read back.
+    let plane_add = object("world", "wall_plane", 0, json!({"planes": [{"coef": [-1.0, 0.0, 0.0, 0.6875]}]}));
+    let tray = object("tool0", "tray", 0, json!({"pose": pose([0.0, 0.0, 0.12], LEVEL), "primitives": [box_msg([0.3, 0.2, 0.04])]}));
+    let attach = json!({"link_name": "tool0", "object": tray, "touch_links": touch});
+    let steps2 = vec![
+        json!({"publish": "collision_object", "msg": plane_add}),
+        json!({"wait_objects": ["crate", "on_table", "wall_plane"]}),
+        states_step(),
+        json!({"publish": "attached_collision_object", "msg": attach}),
+        json!({"wait_objects": ["crate", "on_table", "wall_plane"], "attached": ["tray"]}),
+        states_step(),
+        json!({"get": 128}),
+    ];
+
     let domain = 66 + std::process::id() % 4;
-    let (node, _out, banner) = start_node(&["--ros-args", "-p", "check_motion:=false"], domain);
+    let semantic = format!("robot_semantic_file:={}", srdf_file.display());
+    let (node, _out, banner) = start_node(&["--ros-args", "-p", "check_motion:=false", "-p", &semantic], domain);
     assert!(banner.contains("planning scene: subscribes collision_object"), "{banner}");
-    let answer = common::run_cyclone_peer("scene_peer.py", &cyclone, &json!({"op": "live", "domain": domain, "timeout": 60, "steps": steps}).to_string());
+    let session = |steps: &[Value]| {
+        common::run_cyclone_peer("scene_peer.py", &cyclone, &json!({"op": "live", "domain": domain, "timeout": 60, "steps": steps}).to_string())
+    };
+    let answer = session(&steps);
+    let answer2 = session(&steps2);
+    // The matrix as get_planning_scene gave it, with the crate allowed against every body,
+    // written back: the crate is as good as gone.
+    let mut acm = answer2["results"][steps2.len() - 1]["allowed_collision_matrix"].clone();
+    let names: Vec<String> = acm["entry_names"].as_array().unwrap().iter().map(|n| n.as_str().unwrap().to_owned()).collect();
+    assert!(names.iter().any(|n| n == "tray") && names.iter().any(|n| n == "shoulder_link"), "the matrix names links and the attached tray: {names:?}");
+    let c = names.iter().position(|n| n == "crate").unwrap();
+    for (i, row) in acm["entry_values"].as_array_mut().unwrap().iter_mut().enumerate() {
+        for (j, v) in row["enabled"].as_array_mut().unwrap().iter_mut().enumerate() {
+            if i == c || j == c {
+                *v = json!(true);
+            }
+        }
+    }
+    let steps3 = vec![json!({"apply": {"is_diff": true, "allowed_collision_matrix": acm}}), states_step()];
+    let answer3 = session(&steps3);
     let err = common::stop_node(node);
     let results = answer["results"].as_array().unwrap();
     assert_eq!(results.len(), steps.len(), "{answer}");
+    assert_eq!(answer3["results"][0], json!({"success": true}), "{answer3}");
+    assert_eq!((&answer2["results"][1]["ok"], &answer2["results"][4]["ok"]), (&json!(true), &json!(true)), "{answer2}");
 
     // Each states step against its twin.
-    let state_steps: Vec<usize> = steps.iter().enumerate().filter(|(_, s)| s.get("states").is_some()).map(|(i, _)| i).collect();
-    assert_eq!(state_steps.len(), story.checkpoints.len());
-    for ((i, (label, _, _)), want) in state_steps.iter().zip(&story.checkpoints).zip(&cli) {
-        let got = results[*i].as_array().unwrap();
-        for (k, (g, w)) in got.iter().zip(want).enumerate() {
-            assert!(g.is_object(), "{label}: state {k} got no report");
-            common::same_report(g, w, &format!("{label}, state {k}"));
+    let mut reported = Vec::new();
+    for (a, st) in [(&answer, &steps), (&answer2, &steps2), (&answer3, &steps3)] {
+        for (r, step) in a["results"].as_array().unwrap().iter().zip(st.iter()) {
+            if step.get("states").is_some() {
+                reported.push(r.as_array().unwrap().clone());
+            }
+        }
+    }
+    assert_eq!(reported.len(), story.checkpoints.len());
+    for (k, ((label, _, _), (got, want))) in story.checkpoints.iter().zip(reported.iter().zip(&cli)).enumerate() {
+        for (i, (g, w)) in got.iter().zip(want).enumerate() {
+            assert!(g.is_object(), "{label}: state {i} got no report");
+            let w = if k >= 5 { as_plane(w, g, "wall_plane") } else { w.clone() };
+            common::same_report(g, &w, &format!("{label}, state {i}"));
         }
     }
     for i in [3, 5, 7] {
@@ -321,7 +440,7 @@ fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
         t += 1_000_000;
         t
     };
-    for step in &steps {
+    for step in steps.iter().chain(&steps2).chain(&steps3) {
         if let Some(s) = step.get("states") {
             for st in s.as_array().unwrap() {
                 let at = next();
@@ -338,14 +457,15 @@ fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
     assert_eq!(written["ok"], true);
     let jsonl = dir.join("replayed.jsonl");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
-        .args(["replay", bag.to_str().unwrap(), "--no-motion", "--jsonl", jsonl.to_str().unwrap()])
+        .args(["replay", bag.to_str().unwrap(), "--no-motion", "--jsonl", jsonl.to_str().unwrap(), "--srdf", srdf_file.to_str().unwrap()])
         .output()
         .unwrap();
     assert!(o.status.success(), "replay: {}", String::from_utf8_lossy(&o.stderr));
     let replayed: Vec<Value> = std::fs::read_to_string(&jsonl).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(replayed.len(), states.len() * story.checkpoints.len());
     for (k, (got, want)) in replayed.iter().zip(cli.iter().flatten()).enumerate() {
-        common::same_report(got, want, &format!("replayed state {k}"));
+        let want = if k >= 5 * states.len() { as_plane(want, got, "wall_plane") } else { want.clone() };
+        common::same_report(got, &want, &format!("replayed state {k}"));
     }
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("no such object"), "replay warns about the refused messages: {stderr}");

@@ -218,6 +218,10 @@ fn check_state_validity_with_an_attached_object_agrees_with_its_twin() {
     assert!(tray_types >= 5, "ROBOT_ATTACHED contacts: {tray_types}");
     // (The peer's warm-up, an empty request, is not honoured before a joint state came: that
     // is the only refusal.)
-    assert_eq!(err.matches("not honoured").count(), err.matches("request not honoured (valid = false): joint 'shoulder_pan_joint' is neither").count(), "{err}");
+    assert_eq!(
+        err.matches("not honoured").count(),
+        err.matches("request not honoured (valid = false): joint 'shoulder_pan_joint' is neither").count(),
+        "{err}"
+    );
     assert!(!err.contains("panicked"), "{err}");
 }
