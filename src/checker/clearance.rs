@@ -24,7 +24,7 @@ pub(crate) fn link_clearance(
     let report = |object: usize, triangle: u32, distance: Real, on_link: Vector, on_object: Vector| ReportClearance {
         link_name: link.name.clone(),
         object_name: scene.objects()[object].name.clone(),
-        triangle,
+        triangle: scene.reported_triangle(object, triangle),
         distance,
         point_on_link: on_link.to_array(),
         point_on_object: on_object.to_array(),

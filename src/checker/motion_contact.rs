@@ -72,7 +72,7 @@ impl Checker {
                 report.contacts.push(ReportContact {
                     link_name: lt.name.clone(),
                     object_name: self.scene().objects()[c.object].name.clone(),
-                    triangle: c.triangle,
+                    triangle: self.scene().reported_triangle(c.object, c.triangle),
                     depth: 0.0,
                     position: c.position.map(|p| p.to_array()),
                     normal: c.normal.to_array(),

@@ -177,11 +177,14 @@ pub(crate) fn add_world_object(
     shapes: &[(WorldShape, Pose)],
     summary: &mut BuildSummary,
 ) -> Result<(), String> {
+    // `triangle` counts over the object's meshes in order (at most 2,000,000 in all).
+    let mut triangles = 0u32;
     for (k, (shape, pose)) in shapes.iter().enumerate() {
         let pose = *object_pose * *pose;
         if let WorldShape::Mesh(data) = shape {
             let body = cache.body(params, id, data, summary).map_err(|e| format!("shape {k} (a mesh): {e}"))?;
-            let _ = scene.add_body(id.to_owned(), pose, body);
+            let _ = scene.add_body_counted(id.to_owned(), pose, body, triangles);
+            triangles = triangles.saturating_add(u32::try_from(data.triangles.len()).unwrap_or(u32::MAX));
             continue;
         }
         if let WorldShape::Plane(coef) = shape {

@@ -45,6 +45,9 @@ pub struct SceneObject {
     pub body: Arc<ObjectBody>,
     /// Its bounding box in the world (a first, cheap reject per target).
     world_aabb: Aabb,
+    /// Added to its cells' triangle indices in reports: a planning-scene object's meshes count
+    /// their triangles on from the meshes before them (0 for the environment's).
+    pub(crate) triangle_base: u32,
 }
 
 impl SceneObject {
@@ -99,8 +102,26 @@ impl Scene {
             ObjectBody::Surface { tree, .. } => transformed_box(&tree.root_aabb(), &pose),
             ObjectBody::Solid(shape) => transformed_box(&shape.local_aabb(), &pose),
         };
-        self.objects.push(Arc::new(SceneObject { name: name.into(), pose, body, world_aabb }));
+        self.objects.push(Arc::new(SceneObject { name: name.into(), pose, body, world_aabb, triangle_base: 0 }));
         self.objects.len() - 1
+    }
+
+    /// [`Scene::add_body`] for a mesh whose triangles are counted from `triangle_base` on.
+    pub(crate) fn add_body_counted(&mut self, name: impl Into<String>, pose: Pose, body: Arc<ObjectBody>, triangle_base: u32) -> usize {
+        let i = self.add_body(name, pose, body);
+        if let Some(o) = self.objects.get_mut(i).and_then(Arc::get_mut) {
+            o.triangle_base = triangle_base;
+        }
+        i
+    }
+
+    /// The triangle index a report gives for cell triangle `triangle` of object `object`
+    /// (`u32::MAX`, a solid's or a plane's, stays).
+    pub(crate) fn reported_triangle(&self, object: usize, triangle: u32) -> u32 {
+        match self.objects.get(object) {
+            Some(o) if triangle != u32::MAX => triangle.saturating_add(o.triangle_base),
+            _ => triangle,
+        }
     }
 
     /// The objects, in the order they were added.

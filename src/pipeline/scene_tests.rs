@@ -339,3 +339,29 @@ fn the_allowed_collision_matrix_travels_and_applies() {
     assert_eq!(p.planning_scene(&diff(bad)).unwrap_err().cause, SkipCause::SceneGeometry);
     assert_eq!(reports(&p), after);
 }
+
+/// `triangle` counts over an object's meshes in message order: a contact with the second mesh
+/// gives its triangle after the first mesh's.
+#[test]
+fn triangles_count_over_the_objects_meshes() {
+    let mut p = Pipeline::new(Params::default()).unwrap();
+    let first = sheet();
+    let skip = first.triangles.len() as u32;
+    let msg = CollisionObject {
+        meshes: vec![first, sheet()],
+        mesh_poses: vec![at(0.0, 0.0, 9.0), at(0.2, -0.3, 0.3)],
+        ..object("world", "scan", CollisionObject::ADD)
+    };
+    p.collision_object(&msg).unwrap();
+    let names: Vec<String> = ARM.iter().map(|s| s.to_string()).collect();
+    let mut rng = oorandom::Rand64::new(5);
+    let mut seen = 0;
+    for _ in 0..150 {
+        let q: Vec<f64> = ARM.iter().map(|_| -2.0 + 4.0 * rng.rand_float()).collect();
+        for c in p.checker().check_joints(&names, &q).unwrap().contacts.iter().filter(|c| c.object_name == "scan") {
+            assert!(c.triangle >= skip && c.triangle < 2 * skip, "{c:?}");
+            seen += 1;
+        }
+    }
+    assert!(seen > 5, "{seen} contacts with the second mesh");
+}
