@@ -10,7 +10,9 @@
 //!   `check_trajectory` off the loop, MoveIt's `check_state_validity`), with the MoveIt messages
 //!   a request is built from;
 //! - [`build_self_pairs`]: the self-collision pairs of a parsed SRDF;
-//! - [`planning_scene_round_trip`]: the planning-scene messages through their bounded decoders.
+//! - [`planning_scene_round_trip`]: the planning-scene messages through their bounded decoders;
+//! - [`planning_scene_apply`]: the planning-scene messages applied to a pipeline as the node
+//!   applies them, with what must hold after each.
 
 use crate::checker::{Checker, SelfPairs};
 use crate::model::Srdf;
@@ -77,6 +79,53 @@ pub fn planning_scene_round_trip(data: &[u8]) -> bool {
         4 => round_trip::<ApplyPlanningSceneRequest>(payload),
         5 => round_trip::<GetPlanningSceneRequest>(payload),
         _ => round_trip::<GetPlanningSceneResponse>(payload),
+    }
+}
+
+/// A planning-scene message applied to `pipeline` as the node applies it: `data`'s first byte
+/// picks the type (CollisionObject, AttachedCollisionObject, PlanningScene, PlanningSceneWorld,
+/// the ApplyPlanningScene request), the rest is its CDR payload. Panics when what must hold does
+/// not: a refused message leaves the checker and the scene as they were; after an applied one,
+/// the scene `get_planning_scene` gives is taken back whole (as a full scene) and gives the same
+/// objects; a state is checked without a panic. Returns whether it decoded.
+pub fn planning_scene_apply(pipeline: &mut Pipeline, data: &[u8]) -> bool {
+    let Some((&kind, payload)) = data.split_first() else {
+        return false;
+    };
+    let before = (std::sync::Arc::clone(pipeline.checker()), pipeline.scene_object_count());
+    let result = match kind % 5 {
+        0 => decode_cdr::<CollisionObject>(payload).map(|m| pipeline.collision_object(&m)),
+        1 => decode_cdr::<AttachedCollisionObject>(payload).map(|m| pipeline.attached_collision_object(&m)),
+        2 => decode_cdr::<PlanningScene>(payload).map(|m| pipeline.planning_scene(&m)),
+        3 => decode_cdr::<PlanningSceneWorld>(payload).map(|m| pipeline.planning_scene_world(&m)),
+        _ => decode_cdr::<ApplyPlanningSceneRequest>(payload).map(|m| pipeline.planning_scene(&m.scene)),
+    };
+    let Ok(result) = result else {
+        return false;
+    };
+    let _ = pipeline.take_warnings();
+    if result.is_err() {
+        assert!(std::sync::Arc::ptr_eq(&before.0, pipeline.checker()), "a refused message changed the checker");
+        assert_eq!(before.1, pipeline.scene_object_count(), "a refused message changed the scene");
+        return true;
+    }
+    use crate::msgs::planning_scene::PlanningSceneComponents as C;
+    let all = C::WORLD_OBJECT_GEOMETRY | C::ROBOT_STATE_ATTACHED_OBJECTS | C::TRANSFORMS | C::ALLOWED_COLLISION_MATRIX;
+    let counts = pipeline.scene_object_count();
+    let scene = pipeline.planning_scene_message(all, crate::msgs::Time::default());
+    if let Err(e) = pipeline.planning_scene(&scene) {
+        panic!("the scene get_planning_scene gives is refused: {}", e.message);
+    }
+    assert_eq!(counts, pipeline.scene_object_count(), "the scene given back holds other objects");
+    let names: Vec<String> = pipeline.checker().robot().joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
+    let _ = pipeline.checker().check_joints(&names, &vec![0.3; names.len()]);
+    true
+}
+
+/// Empties the planning scene (a full scene with nothing in it).
+pub fn planning_scene_clear(pipeline: &mut Pipeline) {
+    if let Err(e) = pipeline.planning_scene(&PlanningScene::default()) {
+        panic!("an empty full scene is refused: {}", e.message);
     }
 }
 

@@ -240,3 +240,25 @@ pub fn bag_sqlite(data: &[u8]) {
 pub fn planning_scene(data: &[u8]) {
     let _ = thickness_collision::fuzz_access::planning_scene_round_trip(data);
 }
+
+/// A planning-scene message (first byte: which type) applied to the bundled workcell's pipeline,
+/// its arm at a known state: see `fuzz_access::planning_scene_apply`. The scene is emptied
+/// after each input (a full, empty scene), so inputs do not build on each other.
+pub fn planning_scene_apply(data: &[u8]) {
+    use thickness_collision::msgs::JointState;
+    thread_local! {
+        static PIPELINE: std::cell::RefCell<Option<thickness_collision::pipeline::Pipeline>> = const { std::cell::RefCell::new(None) };
+    }
+    PIPELINE.with(|cell| {
+        let mut cell = cell.borrow_mut();
+        let pipeline = cell.get_or_insert_with(|| {
+            let mut p = crate::fixtures::fresh_pipeline();
+            let name: Vec<String> = p.checker().robot().joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
+            let position = vec![0.2; name.len()];
+            let _ = p.joint_state(&JointState { name, position, ..Default::default() });
+            p
+        });
+        let _ = thickness_collision::fuzz_access::planning_scene_apply(pipeline, data);
+        thickness_collision::fuzz_access::planning_scene_clear(pipeline);
+    });
+}

@@ -29,7 +29,7 @@ mod requests;
 mod seeds;
 
 pub use self::cdr_records::{cdr_records, split_records, CdrKind};
-pub use self::entries::{bag_mcap, bag_sqlite, cdr, mesh_dae, mesh_obj, mesh_stl, params_yaml, planning_scene, srdf, state_line, urdf};
+pub use self::entries::{bag_mcap, bag_sqlite, cdr, mesh_dae, mesh_obj, mesh_stl, params_yaml, planning_scene, planning_scene_apply, srdf, state_line, urdf};
 pub use self::fixtures::{workcell, CONTAINED_PANIC_PREFIX};
 pub use self::requests::{assert_validity_answer, check_state_validity, check_trajectory};
 pub use self::seeds::seeds;
@@ -53,4 +53,5 @@ pub const TARGETS: &[(&str, Entry)] = &[
     ("check_state_validity", check_state_validity),
     ("srdf", srdf),
     ("planning_scene", planning_scene),
+    ("planning_scene_apply", planning_scene_apply),
 ];

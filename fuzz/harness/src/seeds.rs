@@ -87,6 +87,7 @@ pub fn seeds() -> Vec<Seed> {
     ];
     for (kind, file, bytes) in scene_bytes {
         out.push(("planning_scene", file.into(), [&[kind][..], bytes].concat()));
+        out.push(("planning_scene_apply", file.into(), [&[kind][..], bytes].concat()));
     }
     // Parameters: the bundled file and the defaults written out.
     let params = std::fs::read(bundled_config_dir().join("params.yaml")).unwrap_or_default();
