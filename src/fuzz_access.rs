@@ -12,7 +12,10 @@
 //! - [`build_self_pairs`]: the self-collision pairs of a parsed SRDF;
 //! - [`planning_scene_round_trip`]: the planning-scene messages through their bounded decoders;
 //! - [`planning_scene_apply`]: the planning-scene messages applied to a pipeline as the node
-//!   applies them, with what must hold after each.
+//!   applies them, with what must hold after each;
+//! - [`collision_object_cdr`] and [`apply_collision_object_cdr`]: a mesh object's message as
+//!   bytes, and those bytes decoded and applied as the node does on arrival (the scene benchmark,
+//!   `benches/scene_update.rs`, times the latter).
 
 use crate::checker::{Checker, SelfPairs};
 use crate::model::Srdf;
@@ -120,6 +123,36 @@ pub fn planning_scene_apply(pipeline: &mut Pipeline, data: &[u8]) -> bool {
     let names: Vec<String> = pipeline.checker().robot().joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
     let _ = pipeline.checker().check_joints(&names, &vec![0.3; names.len()]);
     true
+}
+
+/// The CDR bytes of a `moveit_msgs/CollisionObject` in `world` with `operation` (0 ADD, 1 REMOVE,
+/// 2 APPEND, 3 MOVE), its pose (x, y, z, qx, qy, qz, qw) and, if given, one mesh.
+pub fn collision_object_cdr(id: &str, operation: u8, pose: [f64; 7], mesh: Option<(&[crate::math::Vector], &[[u32; 3]])>) -> Vec<u8> {
+    use crate::msgs::planning_scene::{MeshTriangle, ShapeMesh};
+    use crate::msgs::{Header, Point, PoseMsg, Quaternion};
+    let [x, y, z, qx, qy, qz, qw] = pose;
+    let meshes = mesh.map_or_else(Vec::new, |(v, t)| {
+        vec![ShapeMesh {
+            vertices: v.iter().map(|p| Point { x: p.x, y: p.y, z: p.z }).collect(),
+            triangles: t.iter().map(|t| MeshTriangle { vertex_indices: *t }).collect(),
+        }]
+    });
+    let msg = CollisionObject {
+        header: Header { frame_id: "world".into(), ..Default::default() },
+        pose: PoseMsg { position: Point { x, y, z }, orientation: Quaternion { x: qx, y: qy, z: qz, w: qw } },
+        id: id.to_owned(),
+        meshes,
+        operation,
+        ..Default::default()
+    };
+    encode_cdr_le(&msg)
+}
+
+/// `bytes` decoded as a `moveit_msgs/CollisionObject` and applied to `pipeline`, as the node does
+/// when one arrives on `collision_object`: the error says why it was not.
+pub fn apply_collision_object_cdr(pipeline: &mut Pipeline, bytes: &[u8]) -> Result<(), String> {
+    let msg = decode_cdr::<CollisionObject>(bytes).map_err(|e| e.to_string())?;
+    pipeline.collision_object(&msg).map_err(|s| s.message)
 }
 
 /// Empties the planning scene (a full scene with nothing in it).
