@@ -13,6 +13,7 @@ mod joint_input;
 mod link_transforms;
 mod planning_world;
 mod report_adapter;
+mod robot_swap;
 mod scene_attached;
 mod scene_input;
 mod scene_state;

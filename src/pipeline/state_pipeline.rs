@@ -21,7 +21,7 @@ const MAX_UNKNOWN_NAMES: usize = 1024;
 
 /// Where the robot came from: it keeps its source when parameters change.
 #[derive(Clone, Debug)]
-enum RobotSource {
+pub(super) enum RobotSource {
     /// The file the parameters name (see [`Params::robot_path`]).
     Files,
     /// A `robot_description` message (URDF text) and what to call it in errors.
@@ -67,7 +67,7 @@ enum StatePose {
 /// Messages in, checked states out. See the module documentation.
 pub struct Pipeline {
     pub(super) checker: Arc<Checker>,
-    source: RobotSource,
+    pub(super) source: RobotSource,
     joints: JointInput,
     pub(super) tf: TfTree,
     skipped: BTreeMap<SkipCause, u64>,
@@ -85,11 +85,11 @@ pub struct Pipeline {
     trail: Option<RobotState>,
     /// The latest `robot_description_semantic` (SRDF text, and what to call it): applied to
     /// every robot built after it that it fits.
-    semantic: Option<(Arc<str>, String)>,
+    pub(super) semantic: Option<(Arc<str>, String)>,
     /// `semantic` is the parameters' `robot_semantic_file`, held for the robot that comes as a
     /// `robot_description` because it does not fit the one the files give: a description it
     /// does not fit is refused, and robots built from files do without it.
-    semantic_deferred: bool,
+    pub(super) semantic_deferred: bool,
 }
 
 impl Pipeline {
@@ -364,112 +364,10 @@ impl Pipeline {
             .collect()
     }
 
-    /// A new robot from URDF text (a `robot_description` message), swapped in whole; on error the
-    /// current robot stays. Merged joint positions are dropped when the new robot's joints differ.
-    pub fn set_robot_description(&mut self, urdf: &str, source: &str) -> Result<(), CheckerError> {
-        let params = self.params().clone();
-        let mut params = params;
-        if self.semantic_deferred {
-            // Applied below from the text read at start, where a misfit refuses the robot.
-            params.robot_semantic_file.clear();
-        }
-        let mut checker = crate::limits::contain_panic(|| Checker::from_description(params, urdf, source)).map_err(CheckerError::Panicked)??;
-        if self.semantic_deferred {
-            if let Some((text, file)) = &self.semantic {
-                crate::limits::contain_panic(|| checker.apply_semantic(text, file))
-                    .map_err(CheckerError::Panicked)?
-                    .map_err(|e| CheckerError::Srdf(format!("robot_semantic_file {file} does not fit this robot: {e}")))?;
-                checker.set_semantic_file_name(file.clone());
-            }
-        } else {
-            self.apply_latest_semantic(&mut checker);
-        }
-        self.source = RobotSource::Description { urdf: urdf.into(), source: source.to_owned() };
-        self.replace(checker);
-        Ok(())
-    }
-
-    /// New parameters: the checker is rebuilt with the robot from the same source (a robot
-    /// received as a description stays); on error everything stays as it was. The input files
-    /// the pipeline started with stay: they are not parameters.
-    pub fn set_params(&mut self, mut params: Params) -> Result<(), CheckerError> {
-        params.input_files = self.params().input_files.clone();
-        let was_deferred = self.semantic_deferred;
-        // A different SRDF file is a new choice, checked against the robot in force.
-        if self.semantic.as_ref().is_none_or(|(_, file)| *file != params.robot_semantic_file) {
-            self.semantic_deferred = false;
-        }
-        match self.rebuild(params) {
-            Ok(checker) => {
-                self.replace(checker);
-                Ok(())
-            }
-            Err(e) => {
-                self.semantic_deferred = was_deferred;
-                Err(e)
-            }
-        }
-    }
-
-    /// A new SRDF (a `robot_description_semantic` message), swapped in whole: its
-    /// `disable_collisions` become the allowed collision matrix and its groups serve
-    /// `check_state_validity`. One naming a link or joint the robot lacks is refused and the
-    /// current matrix stays; it is tried again on every robot that arrives later.
-    pub fn set_robot_semantic(&mut self, text: &str, source: &str) -> Result<(), CheckerError> {
-        // Kept even when it does not fit this robot: the robot it belongs to may come next.
-        self.semantic = Some((text.into(), source.to_owned()));
-        self.semantic_deferred = false;
-        let checker = crate::limits::contain_panic(|| self.checker.with_other_semantic(text, source)).map_err(CheckerError::Panicked)??;
-        // A new SRDF is the matrix from now on, in place of one a planning scene gave.
-        self.scene.matrix = None;
-        self.replace(checker);
-        Ok(())
-    }
-
-    /// The checker for `params` with the robot from the current source, and the latest SRDF
-    /// received when it fits (else the parameters' file or the default pairs, with a warning).
-    fn rebuild(&mut self, params: Params) -> Result<Checker, CheckerError> {
-        let mut checker = self.build_from_source(params)?;
-        if !self.semantic_deferred {
-            self.apply_latest_semantic(&mut checker);
-        }
-        Ok(checker)
-    }
-
-    fn build_from_source(&self, mut params: Params) -> Result<Checker, CheckerError> {
-        let deferred = self.semantic_deferred.then(|| std::mem::take(&mut params.robot_semantic_file));
-        let mut checker = self.build_checker(params)?;
-        if let Some(file) = deferred {
-            if let (RobotSource::Description { .. }, Some((text, _))) = (&self.source, &self.semantic) {
-                checker.apply_semantic(text, &file).map_err(|e| CheckerError::Srdf(format!("robot_semantic_file {file} does not fit this robot: {e}")))?;
-            }
-            checker.set_semantic_file_name(file);
-        }
-        Ok(checker)
-    }
-
-    fn build_checker(&self, params: Params) -> Result<Checker, CheckerError> {
-        crate::limits::contain_panic(|| match &self.source {
-            RobotSource::Files => Checker::from_params(params),
-            RobotSource::Description { urdf, source } => Checker::from_description(params, urdf, source),
-        })
-        .map_err(CheckerError::Panicked)?
-    }
-
-    fn apply_latest_semantic(&mut self, checker: &mut Checker) {
-        if let Some((text, source)) = &self.semantic {
-            match crate::limits::contain_panic(|| checker.apply_semantic(text, source)) {
-                Ok(Ok(())) => {}
-                Ok(Err(e)) => self.warnings.push(format!("the SRDF from {source} does not fit this robot ({e}); its self-collision pairs are not used")),
-                Err(e) => self.warnings.push(format!("the SRDF from {source} could not be applied: {e}")),
-            }
-        }
-    }
-
     /// A new robot, environment or parameters: the planning scene's objects are put beside the
     /// environment again (an object that cannot be, say with an id that is now a robot link's,
     /// drops the scene's objects, warned).
-    fn replace(&mut self, checker: Checker) {
+    pub(super) fn replace(&mut self, checker: Checker) {
         let checker = if self.scene.is_empty() {
             checker
         } else {
