@@ -55,7 +55,11 @@ fn main() {
         time(&mut pipeline, &readd, &mut t_readd);
     }
     let (add_s, move_s, readd_s) = (median(t_add.clone()), median(t_move), median(t_readd));
-    eprintln!("ADD (decode, cells, tree, swap): median {:.1} ms (runs: {:?} ms)", add_s * 1e3, t_add.iter().map(|s| (s * 1e4).round() / 10.0).collect::<Vec<_>>());
+    eprintln!(
+        "ADD (decode, cells, tree, swap): median {:.1} ms (runs: {:?} ms)",
+        add_s * 1e3,
+        t_add.iter().map(|s| (s * 1e4).round() / 10.0).collect::<Vec<_>>()
+    );
     eprintln!("MOVE: median {:.2} ms; re-ADD of the same geometry at a new pose: median {:.2} ms", move_s * 1e3, readd_s * 1e3);
     println!(
         "SCENE_UPDATE {{\"triangles\": {}, \"add_s\": {add_s:.6}, \"move_s\": {move_s:.6}, \"readd_s\": {readd_s:.6}, \"repeat\": {repeat}, \"bytes\": {}}}",

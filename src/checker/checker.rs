@@ -53,6 +53,9 @@ pub struct Checker {
     /// `moving[j]`: joint `j` takes a position from joint states and moves a checked link (itself,
     /// or through a mimic). A state is complete when all of these are known.
     pub(super) moving: Vec<bool>,
+    /// While a planning scene's collision matrix decides the robot's pairs: the pairs of the
+    /// SRDF (or the default reasoning) it replaced, which come back with a scene without one.
+    pub(super) srdf_pairs: Option<Arc<Vec<(usize, usize)>>>,
     /// The first targets are the robot's links; objects attached to them follow.
     pub(super) robot_targets: usize,
     /// The scene's first objects are the environment's; planning-scene objects follow.

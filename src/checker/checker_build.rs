@@ -119,6 +119,7 @@ impl Checker {
             motion: OnceLock::new(),
             self_pairs: SelfPairs::default(),
             moving,
+            srdf_pairs: None,
             robot_targets,
             environment_objects: scene_objects,
             environment_frames: Arc::new(environment_frames),
@@ -170,6 +171,7 @@ impl Checker {
             motion: self.motion.clone(),
             self_pairs,
             moving: self.moving.clone(),
+            srdf_pairs: self.srdf_pairs.clone(),
             robot_targets: self.robot_targets,
             environment_objects: self.environment_objects,
             environment_frames: Arc::clone(&self.environment_frames),
@@ -180,6 +182,7 @@ impl Checker {
     pub(crate) fn apply_semantic(&mut self, text: &str, source: &str) -> Result<(), CheckerError> {
         let srdf = Srdf::parse(text, source, &self.robot).map_err(|e| CheckerError::Srdf(e.to_string()))?;
         self.self_pairs = SelfPairs::build(self, Some(srdf));
+        self.srdf_pairs = None;
         Ok(())
     }
 }

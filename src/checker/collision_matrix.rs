@@ -29,11 +29,13 @@ impl CollisionMatrix {
         Ok(CollisionMatrix { names, index, allowed, defaults })
     }
 
-    /// Whether `a` and `b` may collide: their entry, else their default entries (either's when
+    /// Whether `a` and `b` may collide: their entry (of a matrix that is not symmetric, the later
+    /// row's, as MoveIt reads it), else their default entries (either's when
     /// one has one, both when both have one), else not.
     pub(crate) fn allows(&self, a: &str, b: &str) -> bool {
         if let (Some(&i), Some(&j)) = (self.index.get(a), self.index.get(b)) {
-            return self.allowed[i][j];
+            // MoveIt's constructor sets both (i, j) and (j, i) row by row: the later row wins.
+            return self.allowed[i.max(j)][i.min(j)];
         }
         match (self.defaults.get(a), self.defaults.get(b)) {
             (None, None) => false,

@@ -82,7 +82,9 @@ impl Checker {
         }
         let mut allowed = allowed_matrix(&self.params, &targets, &scene);
         let mut pairs = self.self_pairs.clone();
-        pairs.pairs.retain(|&(_, b)| b < self.robot_targets);
+        // The robot's own pairs: the SRDF's, also when a matrix stood in for them until now.
+        let srdf_pairs = self.srdf_pairs.clone().unwrap_or_else(|| Arc::new(pairs.pairs.iter().copied().filter(|&(_, b)| b < self.robot_targets).collect()));
+        pairs.pairs = srdf_pairs.to_vec();
         if let Some(m) = matrix {
             for (row, t) in allowed.iter_mut().zip(&targets) {
                 for (cell, o) in row.iter_mut().zip(scene.objects()) {
@@ -105,6 +107,7 @@ impl Checker {
             pairs.pairs.clear();
         }
         let mut checker = self.rebuilt(scene, allowed, pairs);
+        checker.srdf_pairs = matrix.map(|_| srdf_pairs);
         if targets.len() != self.robot_targets || self.targets.len() != self.robot_targets {
             // Motion bounds and the joints a state must give follow the targets.
             checker.moving = moving_joints(&self.robot, &targets);

@@ -71,7 +71,15 @@ impl SceneState {
             shapes
         };
         match self.attached.get_mut(id) {
-            Some(a) if object.operation == CollisionObject::APPEND && a.link == msg.link_name => a.shapes.extend(shapes),
+            Some(a) if object.operation == CollisionObject::APPEND && a.link == msg.link_name => {
+                a.shapes.extend(shapes);
+                // Touch links merge, as MoveIt keeps them in a set.
+                for l in &msg.touch_links {
+                    if !a.touch_links.contains(l) {
+                        a.touch_links.push(l.clone());
+                    }
+                }
+            }
             Some(a) if object.operation == CollisionObject::APPEND => {
                 return Err(refuse(SkipCause::SceneGeometry, format!("{what}: APPEND to an object attached to another link ('{}')", a.link)));
             }

@@ -63,6 +63,13 @@ impl Pipeline {
         let robot_link = |li: usize| poses.get(li).map(pose_from_isometry).ok_or_else(|| format!("no pose for link {li}"));
         let ctx = FrameContext { checker: &self.checker, robot_link: &robot_link };
         for a in &state.attached_collision_objects {
+            // The scene of a request stays the node's: the held copy would meet the world's.
+            if self.scene.world.get(&a.object.id).is_some() {
+                return Err(format!(
+                    "robot_state.attached_collision_objects: '{}' is a world object; attaching it in a request is not supported (attach it on attached_collision_object)",
+                    a.object.id
+                ));
+            }
             scene.apply_attached(&ctx, a).map_err(|s| format!("robot_state.attached_collision_objects: {}", s.message))?;
         }
         self.checker

@@ -154,19 +154,23 @@ impl SceneState {
 
     /// The scene's bounds after an object `id` grew: objects, and triangles per object and in all.
     pub(super) fn check_bounds(&self, id: &str) -> Result<(), Skip> {
-        if self.world.len() > MAX_SCENE_OBJECTS {
+        if self.world.len() + self.attached.len() > MAX_SCENE_OBJECTS {
             return Err(refuse(SkipCause::SceneBounds, format!("collision object '{id}': the scene would hold more than {MAX_SCENE_OBJECTS} objects")));
         }
         let per_object = |o: &super::planning_world::WorldObject<WorldShape>| -> usize {
             o.shapes.iter().map(|(s, _)| if let WorldShape::Mesh(m) = s { m.triangles.len() } else { 0 }).sum()
         };
-        if self.world.get(id).map_or(0, per_object) > MAX_OBJECT_TRIANGLES {
+        let mesh_triangles =
+            |shapes: &[(WorldShape, Pose)]| -> usize { shapes.iter().map(|(s, _)| if let WorldShape::Mesh(m) = s { m.triangles.len() } else { 0 }).sum() };
+        let attached = self.attached.get(id).map_or(0, |a| mesh_triangles(&a.shapes));
+        if self.world.get(id).map_or(0, per_object).max(attached) > MAX_OBJECT_TRIANGLES {
             return Err(refuse(
                 SkipCause::SceneBounds,
                 format!("collision object '{id}': meshes: more than the {MAX_OBJECT_TRIANGLES} triangles an object may hold"),
             ));
         }
-        let all: usize = self.world.objects().map(|(_, o)| per_object(o)).sum();
+        let all: usize =
+            self.world.objects().map(|(_, o)| per_object(o)).sum::<usize>() + self.attached.values().map(|a| mesh_triangles(&a.shapes)).sum::<usize>();
         if all > MAX_SCENE_TRIANGLES {
             return Err(refuse(
                 SkipCause::SceneBounds,

@@ -308,7 +308,8 @@ fn a_plane_is_a_thin_surface_without_an_edge() {
 
 /// The allowed collision matrix: `get_planning_scene` gives the one in force (the default
 /// reasoning's pairs without an SRDF); written back it changes nothing; an entry that allows a
-/// link and an object silences that pair only; a new SRDF replaces it.
+/// link and an object silences that pair only; a full scene without a matrix brings the robot's
+/// own pairs back; a new SRDF replaces it.
 #[test]
 fn the_allowed_collision_matrix_travels_and_applies() {
     let mut p = Pipeline::new(Params::default()).unwrap();
@@ -334,10 +335,27 @@ fn the_allowed_collision_matrix_travels_and_applies() {
         "only the allowed pair changes"
     );
     // A bad matrix is refused whole.
-    let mut bad = acm;
+    let mut bad = acm.clone();
     let _ = bad.entry_values.pop();
     assert_eq!(p.planning_scene(&diff(bad)).unwrap_err().cause, SkipCause::SceneGeometry);
     assert_eq!(reports(&p), after);
+    // A matrix that allows two links: their pair goes; a full scene without a matrix brings the
+    // default reasoning's pairs back.
+    let mut links = acm.clone();
+    let (a, b) = pairs[0];
+    let (na, nb) = (p.checker().targets()[a].name.clone(), p.checker().targets()[b].name.clone());
+    let (ia, ib) = (links.entry_names.iter().position(|n| *n == na).unwrap(), links.entry_names.iter().position(|n| *n == nb).unwrap());
+    links.entry_values[ia].enabled[ib] = true;
+    links.entry_values[ib].enabled[ia] = true;
+    p.planning_scene(&diff(links.clone())).unwrap();
+    assert!(!p.checker().self_pairs().pairs.contains(&(a, b)));
+    p.planning_scene(&PlanningScene::default()).unwrap();
+    assert_eq!(p.checker().self_pairs().pairs, pairs, "a full scene without a matrix: the SRDF's (default) pairs again");
+    // A new SRDF replaces a scene's matrix.
+    p.planning_scene(&diff(links)).unwrap();
+    let srdf = "<robot name=\"tc_arm\"></robot>";
+    p.set_robot_semantic(srdf, "test").unwrap();
+    assert!(p.checker().self_pairs().pairs.contains(&(a, b)), "an SRDF that disables nothing checks the pair again");
 }
 
 /// `triangle` counts over an object's meshes in message order: a contact with the second mesh

@@ -26,7 +26,8 @@
 //!   attached object have `ROBOT_ATTACHED` body types.
 //!
 //! As for `check_trajectory`, the work is split so the node can check off its event loop:
-//! [`Pipeline::validity_job`] validates and resolves (linear in the request, no geometry) and
+//! [`Pipeline::validity_job`] validates and resolves (linear in the request; the hulls of the
+//! objects a request attaches are built here, no cells) and
 //! [`ValidityJob::run`], holding the checker it started with, runs on any thread.
 
 use super::Pipeline;
@@ -66,7 +67,7 @@ struct Plan {
 
 impl Pipeline {
     /// Validates `req` and resolves it to a position for every joint and the links its group
-    /// covers. Cheap (no geometry); see [`ValidityJob::run`].
+    /// covers. Cheap (no cells; the hulls of attached objects); see [`ValidityJob::run`].
     pub(crate) fn validity_job(&self, req: &GetStateValidityRequest) -> ValidityJob {
         let (links, warning) = group_links(self.checker(), &req.group_name);
         let plan = refusal(self.checker().robot(), req).map_or_else(|| resolve(self, req).map(|q| Plan { q, links }), Err);
