@@ -32,6 +32,7 @@ pub use self::state_pipeline::{Pipeline, RobotState};
 // The node's and replay's own steps: `/tf` of a state, and the request jobs the node's workers run
 // (the fuzz harness reaches the jobs through `fuzz_access`).
 pub(crate) use self::link_transforms::link_transforms;
+pub(crate) use self::scene_input::{BuiltScene, ScenePlan};
 pub(crate) use self::trajectory::TrajectoryJob;
 #[cfg(feature = "ros")]
 pub(crate) use self::validity::ValidityJob;

@@ -7,6 +7,7 @@
 use super::scene_state::{FrameContext, SceneState};
 use super::skip::{Skip, SkipCause};
 use super::state_pipeline::Pipeline;
+use crate::checker::BodyCache;
 use crate::checker::Checker;
 use crate::math::{pose_from_isometry, Pose};
 use crate::model::PoseSource;
@@ -15,29 +16,101 @@ use crate::msgs::planning_scene::{AttachedCollisionObject, CollisionObject, Octo
 use crate::msgs::Time;
 use std::sync::Arc;
 
+/// A scene message accepted and its next scene worked out, the cells still to build: what
+/// [`ScenePlan::build`] does off the pipeline (the node builds without holding its state, so the
+/// states that arrive meanwhile are checked against the scene in force), before
+/// [`Pipeline::install_scene`] puts the result in force.
+pub(crate) struct ScenePlan {
+    next: SceneState,
+    base: Arc<Checker>,
+    bodies: BodyCache,
+}
+
+/// A built [`ScenePlan`]: the new scene and its checker, or why the scene could not be built.
+pub(crate) struct BuiltScene {
+    next: SceneState,
+    checker: Result<Checker, Skip>,
+    bodies: BodyCache,
+}
+
+impl ScenePlan {
+    /// Builds the new scene's cells (those the cache lacks) and its checker.
+    pub(crate) fn build(mut self) -> BuiltScene {
+        let objects = self.next.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
+        let attached = self.next.attached_specs();
+        let checker = self
+            .base
+            .with_scene(objects, &attached, self.next.matrix.as_ref(), &mut self.bodies)
+            .map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() });
+        drop(attached);
+        BuiltScene { next: self.next, checker, bodies: self.bodies }
+    }
+}
+
 impl Pipeline {
     /// A `moveit_msgs/CollisionObject` (the `collision_object` topic).
     pub(crate) fn collision_object(&mut self, msg: &CollisionObject) -> Result<(), Skip> {
-        self.change_scene(|s, ctx| s.apply_object(ctx, msg))
+        let plan = self.prepare_collision_object(msg)?;
+        self.install_scene(plan.build())
     }
 
     /// A `moveit_msgs/PlanningSceneWorld` (the `planning_scene_world` topic): its objects replace
     /// the world's.
     pub(crate) fn planning_scene_world(&mut self, msg: &PlanningSceneWorld) -> Result<(), Skip> {
-        self.refuse_octomap(&msg.octomap);
-        self.change_scene(|s, ctx| s.apply_world(ctx, msg))
+        let plan = self.prepare_planning_scene_world(msg)?;
+        self.install_scene(plan.build())
     }
 
     /// A `moveit_msgs/PlanningScene` (the `planning_scene` topic, the `apply_planning_scene`
     /// request): a difference, or the whole scene when `is_diff` is false.
     pub(crate) fn planning_scene(&mut self, msg: &PlanningScene) -> Result<(), Skip> {
-        self.refuse_octomap(&msg.world.octomap);
-        self.change_scene(|s, ctx| s.apply_scene(ctx, msg))
+        let plan = self.prepare_planning_scene(msg)?;
+        self.install_scene(plan.build())
     }
 
     /// A `moveit_msgs/AttachedCollisionObject` (the `attached_collision_object` topic).
     pub(crate) fn attached_collision_object(&mut self, msg: &AttachedCollisionObject) -> Result<(), Skip> {
-        self.change_scene(|s, ctx| s.apply_attached(ctx, msg))
+        let plan = self.prepare_attached_collision_object(msg)?;
+        self.install_scene(plan.build())
+    }
+
+    /// [`Pipeline::collision_object`] up to the cells: validated, frames resolved.
+    pub(crate) fn prepare_collision_object(&mut self, msg: &CollisionObject) -> Result<ScenePlan, Skip> {
+        self.prepare_scene(|s, ctx| s.apply_object(ctx, msg))
+    }
+
+    /// [`Pipeline::planning_scene_world`] up to the cells.
+    pub(crate) fn prepare_planning_scene_world(&mut self, msg: &PlanningSceneWorld) -> Result<ScenePlan, Skip> {
+        self.refuse_octomap(&msg.octomap);
+        self.prepare_scene(|s, ctx| s.apply_world(ctx, msg))
+    }
+
+    /// [`Pipeline::planning_scene`] up to the cells.
+    pub(crate) fn prepare_planning_scene(&mut self, msg: &PlanningScene) -> Result<ScenePlan, Skip> {
+        self.refuse_octomap(&msg.world.octomap);
+        self.prepare_scene(|s, ctx| s.apply_scene(ctx, msg))
+    }
+
+    /// [`Pipeline::attached_collision_object`] up to the cells.
+    pub(crate) fn prepare_attached_collision_object(&mut self, msg: &AttachedCollisionObject) -> Result<ScenePlan, Skip> {
+        self.prepare_scene(|s, ctx| s.apply_attached(ctx, msg))
+    }
+
+    /// Puts a built scene in force (a refusal is counted and leaves the scene as it was). The
+    /// plan must be the last one prepared: nothing may change the pipeline's checker between.
+    pub(crate) fn install_scene(&mut self, built: BuiltScene) -> Result<(), Skip> {
+        self.bodies = built.bodies;
+        match built.checker {
+            Ok(checker) => {
+                self.scene = built.next;
+                self.swap(checker);
+                Ok(())
+            }
+            Err(skip) => {
+                self.count_skip(skip.cause, 1);
+                Err(skip)
+            }
+        }
     }
 
     /// The scene in force as `get_planning_scene` answers (`components` as in
@@ -97,24 +170,13 @@ impl Pipeline {
         }
     }
 
-    /// Applies `change` to a copy of the scene in force and, when it succeeds and the checker of
-    /// the new scene is built, puts both in force.
-    fn change_scene(&mut self, change: impl FnOnce(&mut SceneState, &FrameContext) -> Result<(), Skip>) -> Result<(), Skip> {
+    /// Applies `change` to a copy of the scene in force: the plan of the new scene, or the
+    /// refusal (counted; nothing changes). The cell cache goes with the plan until it is installed.
+    fn prepare_scene(&mut self, change: impl FnOnce(&mut SceneState, &FrameContext) -> Result<(), Skip>) -> Result<ScenePlan, Skip> {
         let mut next = self.scene.clone();
         let robot_link = |li| self.robot_link_pose(li);
-        let result = change(&mut next, &FrameContext { checker: &self.checker, robot_link: &robot_link }).and_then(|()| {
-            let objects = next.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
-            let attached = next.attached_specs();
-            self.checker
-                .with_scene(objects, &attached, next.matrix.as_ref(), &mut self.bodies)
-                .map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() })
-        });
-        match result {
-            Ok(checker) => {
-                self.scene = next;
-                self.swap(checker);
-                Ok(())
-            }
+        match change(&mut next, &FrameContext { checker: &self.checker, robot_link: &robot_link }) {
+            Ok(()) => Ok(ScenePlan { next, base: Arc::clone(&self.checker), bodies: std::mem::take(&mut self.bodies) }),
             Err(skip) => {
                 self.count_skip(skip.cause, 1);
                 Err(skip)

@@ -270,6 +270,20 @@ impl Running<'_> {
                 let mut held = self.hold();
                 // A parameter change accepted before this input arrived applies to it.
                 held.state.apply_params(io, self.changes);
+                // A planning-scene input: its cells are built with the state free, so the states
+                // that arrive meanwhile are answered (on the receiving thread) against the scene
+                // in force; nothing else changes the checker before it is installed.
+                let event = match held.state.take_scene_event(io, event) {
+                    Ok(pending) => {
+                        drop(held);
+                        if let Some(pending) = pending {
+                            let built = pending.build();
+                            self.hold().state.finish_scene(io, built);
+                        }
+                        continue;
+                    }
+                    Err(event) => event,
+                };
                 match event {
                     Event::States => on_receive.answer_waiting(&mut held, io, false),
                     Event::Tick => tick_due = true,

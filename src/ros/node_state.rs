@@ -13,10 +13,10 @@ use crate::limits::MAX_DESCRIPTION_BYTES;
 use crate::markers::{cell_markers, contact_markers};
 use crate::model::Params;
 use crate::msgs::moveit::{GetStateValidityRequest, GetStateValidityResponse};
-use crate::msgs::planning_scene::{ApplyPlanningSceneRequest, ApplyPlanningSceneResponse, GetPlanningSceneRequest, GetPlanningSceneResponse};
+use crate::msgs::planning_scene::{ApplyPlanningSceneResponse, GetPlanningSceneRequest, GetPlanningSceneResponse};
 use crate::msgs::{CheckStatesRequest, CheckStatesResponse};
 use crate::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, JointState, TfMessage, Time};
-use crate::pipeline::{Pipeline, RobotState, Skip, SkipCause};
+use crate::pipeline::{BuiltScene, Pipeline, RobotState, ScenePlan, Skip, SkipCause};
 use ros2_client::service::RmwRequestId;
 use ros2_client::{MessageInfo, Node, ReadError};
 use std::sync::{Arc, Mutex};
@@ -41,6 +41,25 @@ fn refusal_line(topic: &str, source: &str, what_stays: &str, error: &str) -> Str
     let error = error.replace('\n', " ");
     let reason = error.strip_prefix(source).and_then(|r| r.strip_prefix(": ")).unwrap_or(&error);
     format!("{topic} rejected, {what_stays}: {reason}")
+}
+
+/// A planning-scene input accepted, its cells still to build.
+pub(super) struct PendingScene {
+    plan: ScenePlan,
+    /// The `apply_planning_scene` request to answer once it is in force.
+    reply: Option<RmwRequestId>,
+}
+
+/// A [`PendingScene`] built (by whoever does not hold the node's state).
+pub(super) struct BuiltPending {
+    scene: BuiltScene,
+    reply: Option<RmwRequestId>,
+}
+
+impl PendingScene {
+    pub(super) fn build(self) -> BuiltPending {
+        BuiltPending { scene: self.plan.build(), reply: self.reply }
+    }
 }
 
 /// The node's state between messages.
@@ -89,19 +108,12 @@ impl NodeState {
             Event::TrajectoryDone(id, answer) => self.send_trajectory_answer(io, id, answer),
             Event::ValidityRequest(id, req) => self.on_validity_request(io, workers, id, req),
             Event::ValidityDone(id, answer, reason) => self.send_validity_answer(io, id, answer, reason),
-            Event::CollisionObject(m) => {
-                let _ = self.on_scene_input(io, |p| p.collision_object(&m));
+            // Prepared here, built without the state held, installed here (`node_run.rs`).
+            Event::CollisionObject(_) | Event::AttachedObject(_) | Event::Scene(_) | Event::SceneWorld(_) | Event::ApplyScene(..) => {
+                if let Ok(Some(pending)) = self.take_scene_event(io, event) {
+                    self.finish_scene(io, pending.build());
+                }
             }
-            Event::AttachedObject(m) => {
-                let _ = self.on_scene_input(io, |p| p.attached_collision_object(&m));
-            }
-            Event::Scene(m) => {
-                let _ = self.on_scene_input(io, |p| p.planning_scene(&m));
-            }
-            Event::SceneWorld(m) => {
-                let _ = self.on_scene_input(io, |p| p.planning_scene_world(&m));
-            }
-            Event::ApplyScene(id, req) => self.on_apply_scene(io, id, &req),
             Event::GetScene(id, req) => self.on_get_scene(io, id, req),
             Event::ReadFailed(what, e) => self.on_read_failed(what, &e),
             Event::States | Event::Parameter(_) | Event::Tick => {}
@@ -318,14 +330,33 @@ impl NodeState {
         }
     }
 
-    /// A planning-scene message, applied by the pipeline before the next input is handled; a
-    /// refused one is warned about and counted, the scene in force unchanged. True when applied.
-    fn on_scene_input(&mut self, io: &Interfaces, apply: impl FnOnce(&mut Pipeline) -> Result<(), Skip>) -> bool {
-        // Building a large object's cells may take a while: a forced stop meanwhile tells the counts.
-        self.refresh_summary();
-        let result = apply(&mut self.pipeline);
+    /// A planning-scene input prepared by the pipeline (validated, frames resolved at the
+    /// current state): the plan whose cells are still to build, `None` when it was refused (warned,
+    /// counted, an `apply_planning_scene` answered false), or the event back when it is not one.
+    pub(super) fn take_scene_event(&mut self, io: &Interfaces, event: Event) -> Result<Option<PendingScene>, Event> {
+        let (prepared, reply) = match event {
+            Event::CollisionObject(m) => (self.pipeline.prepare_collision_object(&m), None),
+            Event::AttachedObject(m) => (self.pipeline.prepare_attached_collision_object(&m), None),
+            Event::Scene(m) => (self.pipeline.prepare_planning_scene(&m), None),
+            Event::SceneWorld(m) => (self.pipeline.prepare_planning_scene_world(&m), None),
+            Event::ApplyScene(id, req) => (self.pipeline.prepare_planning_scene(&req.scene), Some(id)),
+            other => return Err(other),
+        };
         self.warn_pending();
-        match result {
+        match prepared {
+            Ok(plan) => Ok(Some(PendingScene { plan, reply })),
+            Err(skip) => {
+                self.warn_skip(&skip);
+                self.answer_apply(io, reply, false);
+                Ok(None)
+            }
+        }
+    }
+
+    /// A built scene put in force (the cells re-sent), or its refusal warned about; an
+    /// `apply_planning_scene` answered once the change is in force.
+    pub(super) fn finish_scene(&mut self, io: &Interfaces, built: BuiltPending) {
+        let success = match self.pipeline.install_scene(built.scene) {
             Ok(()) => {
                 self.publish_cells(io);
                 true
@@ -334,14 +365,13 @@ impl NodeState {
                 self.warn_skip(&skip);
                 false
             }
-        }
+        };
+        self.refresh_summary();
+        self.answer_apply(io, built.reply, success);
     }
 
-    /// `apply_planning_scene`: `success` once the scene is in force (every state handled after
-    /// the reply is checked against it), false when it was refused (the scene unchanged).
-    fn on_apply_scene(&mut self, io: &Interfaces, id: RmwRequestId, req: &ApplyPlanningSceneRequest) {
-        let success = self.on_scene_input(io, |p| p.planning_scene(&req.scene));
-        let Some(doors) = &io.scene else { return };
+    fn answer_apply(&mut self, io: &Interfaces, reply: Option<RmwRequestId>, success: bool) {
+        let (Some(id), Some(doors)) = (reply, &io.scene) else { return };
         if doors.apply.send_response(id, ApplyPlanningSceneResponse { success }).is_err() {
             self.on_send_failed(&io.names.apply_planning_scene);
         }
