@@ -28,6 +28,10 @@ stdin (live): {"op": "live", "domain": id, "ns": "" or "/ns", "timeout": s, "ste
                                                      REPORT = {"stamp": ns, "in_collision", "error", "contacts": [{"link_name",
                                                      "object_name", "object_type", "triangle", "depth", "normal": [x, y, z],
                                                      "position": [x, y, z]}]}
+  {"apply_streaming": {...PlanningScene...}, "state": {"name", "position"}, "period": s, "timeout": s}
+                                                     {"success", "reply": s, "sent": n, "reports": [{"sent": s, "reported": s,
+                                                     "objects": [...]}]}: apply_planning_scene called while the state is sent
+                                                     every `period` (fresh stamps) until the reply; times from the request
   {"sleep": s}                                       {}
 stdout (live): {"results": [...], "diagnostics": {key: value}} (the last value of each /diagnostics key, read until
   1.5 s after the last step).
@@ -108,11 +112,13 @@ def live(req):
             msg_idl.from_json(SCENE_TOPICS[s["publish"]], s.get("msg", {}))
         elif "apply" in s:
             msg_idl.from_json("moveit_msgs/msg/PlanningScene", s["apply"])
+        elif "apply_streaming" in s:
+            msg_idl.from_json("moveit_msgs/msg/PlanningScene", s["apply_streaming"])
 
     # Wait for what the steps use to match.
     need_w = {writers[s["publish"]] for s in steps if "publish" in s}
-    need_w |= {js_w} if any("states" in s for s in steps) else set()
-    need_c = [c for c, used in [(apply_c, any("apply" in s for s in steps)),
+    need_w |= {js_w} if any("states" in s or "apply_streaming" in s for s in steps) else set()
+    need_c = [c for c, used in [(apply_c, any("apply" in s or "apply_streaming" in s for s in steps)),
                                 (get_c, any("get" in s or "wait_objects" in s for s in steps))] if used]
     deadline = time.time() + req.get("timeout", 30)
     while time.time() < deadline and (any(w.get_matched_subscriptions() == [] for w in need_w) or any(
@@ -171,6 +177,34 @@ def live(req):
             out["seen_attached"] = seen_attached
         return out
 
+    def apply_streaming(s):
+        """apply_planning_scene called while joint states stream: the reply's time, and each
+        state's send and report times (seconds from the request) and the objects it touched."""
+        scene = s["apply_streaming"]
+        k = apply_c.send(scene)
+        t0, period, sent, reports, reply_at, success = time.time(), float(s.get("period", 0.005)), {}, {}, None, None
+        end = t0 + float(s.get("timeout", 20.0))
+        next_send = t0
+        while time.time() < end and (reply_at is None or time.time() < reply_at + 0.3):
+            now = time.time()
+            if reply_at is None and now >= next_send:
+                stamp = next_stamp[0]
+                next_stamp[0] += 1_000_000
+                js_w.write(msg_idl.from_json("sensor_msgs/msg/JointState", joint_state_json(s["state"]["name"], s["state"]["position"], stamp)))
+                sent[stamp] = now - t0
+                next_send = now + period
+            for r in reports_r.take(N=100):
+                if hasattr(r, "header"):
+                    st = r.header.stamp.sec * 1_000_000_000 + r.header.stamp.nanosec
+                    if st in sent and st not in reports:
+                        reports[st] = {"sent": sent[st], "reported": time.time() - t0, "objects": sorted({c.object_name for c in r.contacts})}
+            for x in apply_c.reply_reader.take(N=10):
+                if int(x.seq) == k and reply_at is None:
+                    reply_at, success = time.time(), bool(x.success)
+            time.sleep(0.001)
+        return {"success": success, "reply": None if reply_at is None else reply_at - t0, "sent": len(sent),
+                "reports": [reports[st] for st in sorted(reports)]}
+
     results = []
     for s in steps:
         if "publish" in s:
@@ -186,6 +220,8 @@ def live(req):
             results.append(wait_objects(s))
         elif "states" in s:
             results.append([state(x) for x in s["states"]])
+        elif "apply_streaming" in s:
+            results.append(apply_streaming(s))
         elif "sleep" in s:
             time.sleep(float(s["sleep"]))
             results.append({})
