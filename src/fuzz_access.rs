@@ -89,7 +89,7 @@ pub fn planning_scene_round_trip(data: &[u8]) -> bool {
 /// picks the type (CollisionObject, AttachedCollisionObject, PlanningScene, PlanningSceneWorld,
 /// the ApplyPlanningScene request), the rest is its CDR payload. Panics when what must hold does
 /// not: a refused message leaves the checker and the scene as they were; after an applied one,
-/// the scene `get_planning_scene` gives is taken back whole (as a full scene) and gives the same
+/// the scene `get_planning_scene` gives (with padding and scale) is taken back whole (as a full scene) and gives the same
 /// objects; a state is checked without a panic. Returns whether it decoded.
 pub fn planning_scene_apply(pipeline: &mut Pipeline, data: &[u8]) -> bool {
     let Some((&kind, payload)) = data.split_first() else {
@@ -113,7 +113,7 @@ pub fn planning_scene_apply(pipeline: &mut Pipeline, data: &[u8]) -> bool {
         return true;
     }
     use crate::msgs::planning_scene::PlanningSceneComponents as C;
-    let all = C::WORLD_OBJECT_GEOMETRY | C::ROBOT_STATE_ATTACHED_OBJECTS | C::TRANSFORMS | C::ALLOWED_COLLISION_MATRIX;
+    let all = C::WORLD_OBJECT_GEOMETRY | C::ROBOT_STATE_ATTACHED_OBJECTS | C::TRANSFORMS | C::ALLOWED_COLLISION_MATRIX | C::LINK_PADDING_AND_SCALING;
     let counts = pipeline.scene_object_count();
     let scene = pipeline.planning_scene_message(all, crate::msgs::Time::default());
     if let Err(e) = pipeline.planning_scene(&scene) {

@@ -12,8 +12,8 @@ use super::skip::{Skip, SkipCause};
 use crate::checker::{Attached, Checker, CollisionMatrix, WorldShape};
 use crate::math::Pose;
 use crate::msgs::planning_scene::{
-    AllowedCollisionEntry, AllowedCollisionMatrix, AttachedCollisionObject, CollisionObject, MeshTriangle, Plane, PlanningScene, PlanningSceneComponents,
-    PlanningSceneWorld, Point32, Polygon, ShapeMesh, SolidPrimitive, MAX_SCENE_OBJECTS,
+    AllowedCollisionEntry, AllowedCollisionMatrix, AttachedCollisionObject, CollisionObject, LinkPadding, LinkScale, MeshTriangle, Plane, PlanningScene,
+    PlanningSceneComponents, PlanningSceneWorld, Point32, Polygon, ShapeMesh, SolidPrimitive, MAX_SCENE_OBJECTS,
 };
 use crate::msgs::{Header, Point, PoseMsg, Quaternion, Time, Transform, TransformStamped, Vector3};
 use std::collections::BTreeMap;
@@ -190,14 +190,11 @@ impl SceneState {
     /// A `PlanningScene`, a difference (`is_diff`) or the whole scene, in MoveIt's order: the
     /// allowed collision matrix (one with entries replaces the one in force), fixed frames, the
     /// robot state's attached objects (all replaced when `robot_state.is_diff` is false), world
-    /// objects. What it holds that is not supported yet refuses it whole (link padding or scale:
-    /// ignoring them would check against a scene the planner does not have). The robot state's joint positions are not used: states come from
+    /// objects. Link padding and scale other than those in force refuse it whole (not supported
+    /// yet: ignoring them would check against a scene the planner does not have). The robot state's joint positions are not used: states come from
     /// `joint_states`.
     pub(super) fn apply_scene(&mut self, ctx: &FrameContext, msg: &PlanningScene) -> Result<(), Skip> {
-        let unsupported = [(!msg.link_padding.is_empty(), "link_padding"), (!msg.link_scale.is_empty(), "link_scale")];
-        if let Some((_, field)) = unsupported.iter().find(|(given, _)| *given) {
-            return Err(refuse(SkipCause::SceneUnsupported, format!("planning scene: {field}: not supported yet; the scene is left as it was")));
-        }
+        padding_and_scale_in_force(ctx.checker, msg)?;
         if !msg.is_diff {
             *self = SceneState::default();
         }
@@ -274,6 +271,11 @@ impl SceneState {
                 }
             };
         }
+        if components & PlanningSceneComponents::LINK_PADDING_AND_SCALING != 0 {
+            let robot = checker.robot();
+            scene.link_padding = robot.links.iter().map(|l| LinkPadding { link_name: l.name.clone(), padding: checker.params().padding_of(&l.name) }).collect();
+            scene.link_scale = robot.links.iter().map(|l| LinkScale { link_name: l.name.clone(), scale: 1.0 }).collect();
+        }
         if components & PlanningSceneComponents::TRANSFORMS != 0 {
             scene.fixed_frame_transforms = self
                 .fixed_frames
@@ -283,6 +285,35 @@ impl SceneState {
         }
         scene
     }
+}
+
+/// `link_padding` and `link_scale` as the node has them (the `padding` parameter's, scale 1), as
+/// `get_planning_scene` gives them back: accepted; any other value refuses the message (a scene
+/// cannot change them yet: checking with other sizes than the planner's would not be the
+/// planner's world). Names that are no robot link are ignored, as MoveIt ignores them.
+fn padding_and_scale_in_force(checker: &Checker, msg: &PlanningScene) -> Result<(), Skip> {
+    let robot = checker.robot();
+    for p in msg.link_padding.iter().filter(|p| robot.link(&p.link_name).is_some()) {
+        let in_force = checker.params().padding_of(&p.link_name);
+        if (p.padding - in_force).abs() > 1e-12 {
+            return Err(refuse(
+                SkipCause::SceneUnsupported,
+                format!(
+                    "planning scene: link_padding: '{}' {} differs from the padding in force {in_force} (set by the padding parameter; a scene cannot change it yet); the scene is left as it was",
+                    p.link_name, p.padding
+                ),
+            ));
+        }
+    }
+    for l in msg.link_scale.iter().filter(|l| robot.link(&l.link_name).is_some()) {
+        if (l.scale - 1.0).abs() > 1e-12 {
+            return Err(refuse(
+                SkipCause::SceneUnsupported,
+                format!("planning scene: link_scale: '{}' {}: only 1 is supported yet; the scene is left as it was", l.link_name, l.scale),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The message's matrix, or why it cannot be read.

@@ -149,9 +149,17 @@ fn scenes_apply_whole_and_travel_back() {
     assert_eq!(p.planning_scene(&half).unwrap_err().cause, SkipCause::SceneId);
     assert_eq!(p.scene_object_count(), (1, 0));
     p.collision_object(&crate_box).unwrap();
-    let all = PlanningSceneComponents::WORLD_OBJECT_GEOMETRY | PlanningSceneComponents::TRANSFORMS;
+    let all = PlanningSceneComponents::WORLD_OBJECT_GEOMETRY | PlanningSceneComponents::TRANSFORMS | PlanningSceneComponents::LINK_PADDING_AND_SCALING;
     let msg = p.planning_scene_message(all, Time::default());
     assert_eq!(msg.world.collision_objects.len(), 2);
+    assert_eq!(msg.link_padding.len(), p.checker().robot().links.len(), "padding and scale of every link, as in force");
+    // Other padding or scale than in force: refused whole (not supported yet).
+    let mut padded = msg.clone();
+    padded.link_padding[1].padding += 0.05;
+    assert_eq!(p.planning_scene(&padded).unwrap_err().cause, SkipCause::SceneUnsupported);
+    let mut scaled = msg.clone();
+    scaled.link_scale[1].scale = 1.1;
+    assert!(p.planning_scene(&scaled).unwrap_err().message.contains("link_scale"));
     let mut fresh = Pipeline::new(Params::default()).unwrap();
     fresh.collision_object(&sheet_at(9.0, 9.0, 9.0)).unwrap();
     fresh.planning_scene(&msg).unwrap();
