@@ -176,7 +176,7 @@ fn attached_pairs(params: &Params, targets: &[LinkTargets], first: usize, attach
     for b in first..targets.len() {
         let Some(a_spec) = attached.iter().find(|a| a.id == targets[b].name) else { continue };
         for (a, t) in targets[..b].iter().enumerate() {
-            let touch = a_spec.touch_links.iter().any(|l| *l == t.name);
+            let touch = a_spec.touch_links.contains(&t.name);
             let allowed = params.is_allowed(&t.name, &targets[b].name) || params.is_allowed(&targets[b].name, &t.name);
             if t.link != targets[b].link && !touch && !allowed {
                 pairs.push((a, b));

@@ -61,6 +61,14 @@ pub(super) enum Event {
     Tick,
 }
 
+impl Event {
+    /// A planning-scene input (topic message or `apply_planning_scene` request): the loop builds
+    /// its cells without holding the node's state (`node_run.rs`).
+    pub(super) fn is_scene(&self) -> bool {
+        matches!(self, Event::CollisionObject(_) | Event::AttachedObject(_) | Event::Scene(_) | Event::SceneWorld(_) | Event::ApplyScene(..))
+    }
+}
+
 /// One source of events for the loop's `select_all`.
 pub(super) type Events<'a> = Pin<Box<dyn Stream<Item = Event> + 'a>>;
 

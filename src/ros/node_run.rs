@@ -273,17 +273,15 @@ impl Running<'_> {
                 // A planning-scene input: its cells are built with the state free, so the states
                 // that arrive meanwhile are answered (on the receiving thread) against the scene
                 // in force; nothing else changes the checker before it is installed.
-                let event = match held.state.take_scene_event(io, event) {
-                    Ok(pending) => {
-                        drop(held);
-                        if let Some(pending) = pending {
-                            let built = pending.build();
-                            self.hold().state.finish_scene(io, built);
-                        }
-                        continue;
+                if event.is_scene() {
+                    let pending = held.state.take_scene_event(io, event);
+                    drop(held);
+                    if let Some(pending) = pending {
+                        let built = pending.build();
+                        self.hold().state.finish_scene(io, built);
                     }
-                    Err(event) => event,
-                };
+                    continue;
+                }
                 match event {
                     Event::States => on_receive.answer_waiting(&mut held, io, false),
                     Event::Tick => tick_due = true,

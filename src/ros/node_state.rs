@@ -110,7 +110,7 @@ impl NodeState {
             Event::ValidityDone(id, answer, reason) => self.send_validity_answer(io, id, answer, reason),
             // Prepared here, built without the state held, installed here (`node_run.rs`).
             Event::CollisionObject(_) | Event::AttachedObject(_) | Event::Scene(_) | Event::SceneWorld(_) | Event::ApplyScene(..) => {
-                if let Ok(Some(pending)) = self.take_scene_event(io, event) {
+                if let Some(pending) = self.take_scene_event(io, event) {
                     self.finish_scene(io, pending.build());
                 }
             }
@@ -330,25 +330,25 @@ impl NodeState {
         }
     }
 
-    /// A planning-scene input prepared by the pipeline (validated, frames resolved at the
-    /// current state): the plan whose cells are still to build, `None` when it was refused (warned,
-    /// counted, an `apply_planning_scene` answered false), or the event back when it is not one.
-    pub(super) fn take_scene_event(&mut self, io: &Interfaces, event: Event) -> Result<Option<PendingScene>, Event> {
+    /// A planning-scene input ([`Event::is_scene`]) prepared by the pipeline (validated, frames
+    /// resolved at the current state): the plan whose cells are still to build, `None` when it was
+    /// refused (warned, counted, an `apply_planning_scene` answered false) or is no scene input.
+    pub(super) fn take_scene_event(&mut self, io: &Interfaces, event: Event) -> Option<PendingScene> {
         let (prepared, reply) = match event {
             Event::CollisionObject(m) => (self.pipeline.prepare_collision_object(&m), None),
             Event::AttachedObject(m) => (self.pipeline.prepare_attached_collision_object(&m), None),
             Event::Scene(m) => (self.pipeline.prepare_planning_scene(&m), None),
             Event::SceneWorld(m) => (self.pipeline.prepare_planning_scene_world(&m), None),
             Event::ApplyScene(id, req) => (self.pipeline.prepare_planning_scene(&req.scene), Some(id)),
-            other => return Err(other),
+            _ => return None,
         };
         self.warn_pending();
         match prepared {
-            Ok(plan) => Ok(Some(PendingScene { plan, reply })),
+            Ok(plan) => Some(PendingScene { plan, reply }),
             Err(skip) => {
                 self.warn_skip(&skip);
                 self.answer_apply(io, reply, false);
-                Ok(None)
+                None
             }
         }
     }
