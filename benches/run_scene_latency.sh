@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Joint-state latency while the planning scene changes (benches/scene_latency.py): the release
 # node on the bundled workcell (check_motion false), a Cyclone DDS peer streaming states at RATE Hz,
-# first quiet, then with a 10,000-triangle sheet added and removed at 10 Hz. Loopback only.
+# first quiet, then with a 10,000-triangle sheet added and removed at 10 Hz; then
+# apply_planning_scene of a 100,000-triangle sheet timed from request to reply. Loopback only.
 #
 #   bash benches/run_scene_latency.sh [RATE] [SECONDS] [TRIANGLES]     # default 1000 5 10000
 set -euo pipefail
@@ -21,3 +22,5 @@ node=$!
 trap 'kill $node 2>/dev/null; rm -f "$cyclone"' EXIT
 sleep 2
 CYCLONEDDS_URI="file://$cyclone" "$python" benches/scene_latency.py "$domain" --rate "$rate" --seconds "$seconds" --triangles "$triangles"
+# And apply_planning_scene of a 100,000-triangle sheet, request to reply (the goal: at most 0.5 s).
+CYCLONEDDS_URI="file://$cyclone" "$python" benches/scene_latency.py "$domain" --apply 100000

@@ -65,6 +65,42 @@ def scene_traffic(args):
         time.sleep(0.001)
 
 
+def apply_timing(args):
+    """apply_planning_scene with an ADD of a sheet of about args.apply triangles (fresh geometry each
+    time), request written to reply taken, 5 times; a REMOVE applied between (also timed)."""
+    import service_client
+    dp = DomainParticipant(args.domain)
+    reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100))
+    Req, Resp = msg_idl.cyclone_service("moveit_msgs/srv/ApplyPlanningScene")
+    w = DataWriter(dp, Topic(dp, "rq/apply_planning_sceneRequest", Req), qos=reliable)
+    r = DataReader(dp, Topic(dp, "rr/apply_planning_sceneReply", Resp), qos=reliable)
+    scenes = []
+    pose = {"position": {"x": 0.0, "y": 0.0, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}
+    for k in range(5):
+        add = {"header": {"frame_id": "world"}, "id": "sheet", "pose": pose, "meshes": [sheet(args.apply, k)], "operation": 0}
+        scenes.append(msg_idl.from_json("moveit_msgs/msg/PlanningScene", {"is_diff": True, "world": {"collision_objects": [add]}}))
+    remove = msg_idl.from_json("moveit_msgs/msg/PlanningScene",
+                               {"is_diff": True, "world": {"collision_objects": [{"header": {"frame_id": "world"}, "id": "sheet", "operation": 1}]}})
+    client = service_client.Client(w, r, lambda scene, seq: Req(guid=0x5C3E7E0A11CE0002, seq=seq, scene=scene))
+    end = time.time() + 30
+    while (w.get_matched_subscriptions() == [] or r.get_matched_publications() == []) and time.time() < end:
+        time.sleep(0.05)
+    client.wait_answer(client.send(remove), 5.0)  # warm-up (and a clean scene)
+    times, removes = [], []
+    for scene in scenes:
+        t = time.time()
+        a = client.wait_answer(client.send(scene), 30.0)
+        times.append(time.time() - t)
+        assert a is not None and a.success, "apply_planning_scene failed"
+        t = time.time()
+        client.wait_answer(client.send(remove), 30.0)
+        removes.append(time.time() - t)
+    n = len(sheet(args.apply, 0)["triangles"])
+    print(f"apply_planning_scene ADD of a {n:,}-triangle sheet, request to reply: median {percentile(times, 0.5) * 1e3:.1f} ms "
+          f"(runs {', '.join(f'{x * 1e3:.0f}' for x in times)} ms); REMOVE: median {percentile(removes, 0.5) * 1e3:.1f} ms")
+    print("SCENE_APPLY " + json.dumps({"triangles": n, "add_s": times, "remove_s": removes}))
+
+
 def percentile(xs, q):
     xs = sorted(xs)
     return xs[min(len(xs) - 1, int(q * len(xs)))] if xs else float("nan")
@@ -77,9 +113,13 @@ def main():
     ap.add_argument("--seconds", type=float, default=5.0)
     ap.add_argument("--triangles", type=int, default=10000)
     ap.add_argument("--scene-only", action="store_true", help="(internal) publish the scene traffic for --seconds, from a process of its own")
+    ap.add_argument("--apply", type=int, default=0, metavar="TRIANGLES",
+                    help="instead: apply_planning_scene of a sheet of about TRIANGLES triangles, request to reply, 5 times (REMOVE between)")
     args = ap.parse_args()
     if args.scene_only:
         return scene_traffic(args)
+    if args.apply:
+        return apply_timing(args)
     dp = DomainParticipant(args.domain)
     sensor = Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(100))
     reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(10000))
