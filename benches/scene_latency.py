@@ -101,6 +101,15 @@ def apply_timing(args):
     print("SCENE_APPLY " + json.dumps({"triangles": n, "add_s": times, "remove_s": removes}))
 
 
+def take_reports(reports, sent, got):
+    """The reports waiting: the arrival time of each sent state's first one into `got`."""
+    for r in reports.take(N=1000):
+        if hasattr(r, "header"):
+            st = r.header.stamp.sec * 10**9 + r.header.stamp.nanosec
+            if st in sent and st not in got:
+                got[st] = time.time()
+
+
 def percentile(xs, q):
     xs = sorted(xs)
     return xs[min(len(xs) - 1, int(q * len(xs)))] if xs else float("nan")
@@ -153,22 +162,14 @@ def main():
                 sent[stamp] = time.time()
                 stamp += 1000
                 next_state += period
-            for r in reports.take(N=1000):
-                if hasattr(r, "header"):
-                    st = r.header.stamp.sec * 10**9 + r.header.stamp.nanosec
-                    if st in sent and st not in got:
-                        got[st] = time.time()
+            take_reports(reports, sent, got)
             time.sleep(0)
         phases[phase] = (first, stamp)
         if traffic is not None:
             traffic.wait()
     drain = time.time() + 1.0
     while time.time() < drain:
-        for r in reports.take(N=1000):
-            if hasattr(r, "header"):
-                st = r.header.stamp.sec * 10**9 + r.header.stamp.nanosec
-                if st in sent and st not in got:
-                    got[st] = time.time()
+        take_reports(reports, sent, got)
         time.sleep(0.001)
     out = {}
     print(f"| phase ({args.rate:.0f} Hz, {args.seconds:.0f} s) | answered | median ms | p99 ms | max ms |")

@@ -12,12 +12,10 @@
 mod common;
 
 use common::start_node;
-use oorandom::Rand64;
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use thickness_collision::checker::Checker;
-use thickness_collision::model::{JointKind, Params};
+use thickness_collision::model::Params;
 
 /// A quaternion (x, y, z, w) as a ROS message, and the same rotation as URDF rpy.
 const TILT: ([f64; 4], [f64; 3]) = ([0.0, std::f64::consts::FRAC_1_SQRT_2, 0.0, std::f64::consts::FRAC_1_SQRT_2], [0.0, std::f64::consts::FRAC_PI_2, 0.0]);
@@ -129,57 +127,14 @@ fn sheet_obj(dir: &Path) -> PathBuf {
 
 /// Random states of the bundled arm within its limits, as `{name, position}`.
 fn random_states(n: usize, seed: u128) -> Vec<Value> {
-    let checker = Checker::from_params(Params::default()).unwrap();
-    let joints: Vec<_> = checker.robot().joints.iter().filter(|j| j.is_actuated()).collect();
-    let names: Vec<String> = joints.iter().map(|j| j.name.clone()).collect();
-    let mut rng = Rand64::new(seed);
-    (0..n)
-        .map(|_| {
-            let q: Vec<f64> = joints
-                .iter()
-                .map(|j| {
-                    let (lo, hi) = if j.kind == JointKind::Continuous { (-3.1, 3.1) } else { (j.limits[0], j.limits[1]) };
-                    lo + (hi - lo) * rng.rand_float()
-                })
-                .collect();
-            json!({"name": names, "position": q})
-        })
-        .collect()
+    let (names, states) = common::random_arm_states(n, seed);
+    states.iter().map(|q| json!({"name": names, "position": q})).collect()
 }
 
 /// The world after each step, as twins.
 struct Story {
     /// (step label, the twin environment file, the object some of the step's states must touch).
     checkpoints: Vec<(&'static str, PathBuf, &'static str)>,
-}
-
-/// An SRDF for the bundled arm that disables exactly what the default reasoning allows (so the
-/// node with it checks what `check` without one does), and the same with the pairs of a fixed
-/// child link `tray` and each touch link disabled: (plain, with the tray).
-fn arm_srdfs(touch: &[&str]) -> (String, String) {
-    let plain = Checker::from_params(Params::default()).unwrap();
-    let targets = plain.targets();
-    let mut srdf = String::from("<robot name=\"tc_arm\">");
-    for a in 0..targets.len() {
-        for b in a + 1..targets.len() {
-            if !plain.self_pairs().pairs.contains(&(a, b)) {
-                let _ = write!(srdf, "<disable_collisions link1=\"{}\" link2=\"{}\" reason=\"Default\"/>", targets[a].name, targets[b].name);
-            }
-        }
-    }
-    let with_tray = touch.iter().fold(srdf.clone(), |s, l| s + &format!("<disable_collisions link1=\"tray\" link2=\"{l}\" reason=\"Touch\"/>"));
-    (srdf + "</robot>", with_tray + "</robot>")
-}
-
-/// The bundled arm holding a tray: a fixed child link `tray` of `tool0` (a 0.3 x 0.2 x 0.04 m box
-/// 0.12 m out along its z), as URDF text with absolute mesh paths.
-fn arm_with_tray() -> String {
-    let config = thickness_collision::model::bundled_config_dir();
-    let tray = "<link name=\"tray\"><collision><origin xyz=\"0 0 0.12\"/><geometry><box size=\"0.3 0.2 0.04\"/></geometry></collision></link><joint name=\"tray_joint\" type=\"fixed\"><parent link=\"tool0\"/><child link=\"tray\"/></joint></robot>";
-    std::fs::read_to_string(config.join("example_workcell/robot.urdf"))
-        .unwrap()
-        .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", config.join("example_workcell/gripper.obj").display()))
-        .replacen("</robot>", tray, 1)
 }
 
 /// `check`'s report for a world with a plane, as the node gives it: the plane's twin is a
@@ -259,11 +214,11 @@ fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
     };
     // The tray's twins are the arm holding it, with the SRDF that disables its touch links.
     let touch = ["gripper_link", "finger_left_link", "finger_right_link"];
-    let (srdf, tray_srdf) = arm_srdfs(&touch);
+    let (srdf, tray_srdf) = common::arm_srdfs(&touch);
     let (srdf_file, tray_srdf_file, tray_urdf) = (dir.join("arm.srdf"), dir.join("tray.srdf"), dir.join("tray.urdf"));
     std::fs::write(&srdf_file, srdf).unwrap();
     std::fs::write(&tray_srdf_file, tray_srdf).unwrap();
-    std::fs::write(&tray_urdf, arm_with_tray()).unwrap();
+    std::fs::write(&tray_urdf, common::arm_with_tray()).unwrap();
     let holding = ["--robot", tray_urdf.to_str().unwrap(), "--srdf", tray_srdf_file.to_str().unwrap()];
     let cli: Vec<Vec<Value>> = story
         .checkpoints
@@ -469,44 +424,4 @@ fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
     }
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("no such object"), "replay warns about the refused messages: {stderr}");
-}
-
-/// States keep being answered while a large object's cells are built: `apply_planning_scene`
-/// adds an 80,000-triangle sheet while the peer sends the arm's state every 5 ms; the states
-/// answered meanwhile were checked against the scene in force (the sheet not in it), and from the
-/// change on against the new one; the same state after the reply touches the sheet.
-#[test]
-fn states_are_answered_while_an_object_is_built() {
-    let dir = common::scratch_dir("ros_planning_scene_streaming");
-    let cyclone = common::cyclone_loopback_file(&dir);
-    let (v, t) = thickness_collision::mesh::generate::wavy_sheet(200, 200, 7.0, 7.0, 0.05, 0.5);
-    let mesh = json!({
-        "vertices": v.iter().map(|p| json!({"x": p.x, "y": p.y, "z": p.z})).collect::<Vec<_>>(),
-        "triangles": t.iter().map(|t| json!({"vertex_indices": t})).collect::<Vec<_>>(),
-    });
-    // A sheet 0.3 m above the table across the whole cell: the upright arm passes through it.
-    let sheet = object("world", "big_sheet", 0, json!({"pose": pose([-3.5, -3.5, 0.3], LEVEL), "meshes": [mesh]}));
-    let arm = random_states(1, 1)[0]["name"].clone();
-    let upright = json!({"name": arm, "position": vec![0.0; arm.as_array().unwrap().len()]});
-    let steps =
-        vec![json!({"states": [upright]}), json!({"apply_streaming": diff(vec![sheet]), "state": upright, "period": 0.005}), json!({"states": [upright]})];
-    let domain = 70 + std::process::id() % 4;
-    let (node, _out, _banner) = start_node(&["--ros-args", "-p", "check_motion:=false"], domain);
-    let answer = common::run_cyclone_peer("scene_peer.py", &cyclone, &json!({"op": "live", "domain": domain, "timeout": 60, "steps": steps}).to_string());
-    let err = common::stop_node(node);
-    let results = answer["results"].as_array().unwrap();
-    let streamed = &results[1];
-    assert_eq!(streamed["success"], true, "{streamed}: {err}");
-    let reply = streamed["reply"].as_f64().unwrap();
-    let during: Vec<&Value> = streamed["reports"].as_array().unwrap().iter().filter(|r| r["reported"].as_f64().unwrap() < reply).collect();
-    eprintln!("reply after {:.0} ms; {} of {} states answered before it", reply * 1e3, during.len(), streamed["sent"]);
-    // In stamp order, the states first meet the scene in force (no sheet), then the new one; a
-    // state checked between the change and the reply's arrival may see it already.
-    let touches: Vec<bool> = streamed["reports"].as_array().unwrap().iter().map(|r| r["objects"].as_array().unwrap().contains(&json!("big_sheet"))).collect();
-    assert!(touches.windows(2).all(|w| w[0] <= w[1]), "never the old scene after the new: {touches:?}");
-    let before = during.iter().filter(|r| !r["objects"].as_array().unwrap().contains(&json!("big_sheet"))).count();
-    assert!(before >= 5, "states answered against the scene in force while the sheet was built: {streamed}");
-    let after = &results[2][0];
-    assert!(after["contacts"].as_array().unwrap().iter().any(|c| c["object_name"] == "big_sheet"), "in force after the reply: {after}");
-    assert!(!err.contains("panicked"), "{err}");
 }

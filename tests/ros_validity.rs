@@ -11,10 +11,7 @@
 mod common;
 
 use common::start_node;
-use oorandom::Rand64;
 use serde_json::{json, Value};
-use thickness_collision::checker::Checker;
-use thickness_collision::model::{JointKind, Params};
 
 /// `check --states FILE --json` on states given by name: one report per state.
 /// The service's answer against `check --json` on the same state: `valid` is "not in
@@ -55,21 +52,7 @@ fn check_state_validity_agrees_with_check_and_refuses_what_it_cannot_honour() {
     let cyclone = common::cyclone_loopback_file(&dir);
 
     // Random states of the bundled arm within its limits, some free and some not.
-    let checker = Checker::from_params(Params::default()).unwrap();
-    let joints: Vec<_> = checker.robot().joints.iter().filter(|j| j.is_actuated()).collect();
-    let names: Vec<String> = joints.iter().map(|j| j.name.clone()).collect();
-    let mut rng = Rand64::new(13);
-    let states: Vec<Vec<f64>> = (0..40)
-        .map(|_| {
-            joints
-                .iter()
-                .map(|j| {
-                    let (lo, hi) = if j.kind == JointKind::Continuous { (-3.1, 3.1) } else { (j.limits[0], j.limits[1]) };
-                    lo + (hi - lo) * rng.rand_float()
-                })
-                .collect()
-        })
-        .collect();
+    let (names, states) = common::random_arm_states(40, 13);
     let lines: Vec<Value> = states.iter().map(|p| json!({"name": names, "position": p})).collect();
     let cli = common::check_json(&dir, "states", &lines, &[]);
     assert_eq!(cli.len(), states.len());
@@ -144,47 +127,16 @@ fn check_state_validity_agrees_with_check_and_refuses_what_it_cannot_honour() {
 /// types.
 #[test]
 fn check_state_validity_with_an_attached_object_agrees_with_its_twin() {
-    use std::fmt::Write as _;
     let dir = common::scratch_dir("ros_validity_attached");
     let cyclone = common::cyclone_loopback_file(&dir);
-    let plain = Checker::from_params(Params::default()).unwrap();
     // One matrix for both sides: an SRDF disabling what the default reasoning allows.
-    let targets = plain.targets();
-    let mut srdf = String::from("<robot name=\"tc_arm\">");
-    for a in 0..targets.len() {
-        for b in a + 1..targets.len() {
-            if !plain.self_pairs().pairs.contains(&(a, b)) {
-                let _ = write!(srdf, "<disable_collisions link1=\"{}\" link2=\"{}\" reason=\"Default\"/>", targets[a].name, targets[b].name);
-            }
-        }
-    }
     let touch = ["gripper_link", "finger_left_link", "finger_right_link"];
-    let twin_srdf = touch.iter().fold(srdf.clone(), |s, l| s + &format!("<disable_collisions link1=\"tray\" link2=\"{l}\" reason=\"Touch\"/>")) + "</robot>";
+    let (srdf, twin_srdf) = common::arm_srdfs(&touch);
     let (srdf_file, twin_srdf_file, twin_urdf) = (dir.join("arm.srdf"), dir.join("twin.srdf"), dir.join("twin.urdf"));
-    std::fs::write(&srdf_file, srdf + "</robot>").unwrap();
+    std::fs::write(&srdf_file, srdf).unwrap();
     std::fs::write(&twin_srdf_file, twin_srdf).unwrap();
-    let config = thickness_collision::model::bundled_config_dir();
-    let tray = "<link name=\"tray\"><collision><origin xyz=\"0 0 0.12\"/><geometry><box size=\"0.3 0.2 0.04\"/></geometry></collision></link><joint name=\"tray_joint\" type=\"fixed\"><parent link=\"tool0\"/><child link=\"tray\"/></joint></robot>";
-    let urdf = std::fs::read_to_string(config.join("example_workcell/robot.urdf"))
-        .unwrap()
-        .replace("filename=\"gripper.obj\"", &format!("filename=\"file://{}\"", config.join("example_workcell/gripper.obj").display()))
-        .replacen("</robot>", tray, 1);
-    std::fs::write(&twin_urdf, urdf).unwrap();
-
-    let joints: Vec<_> = plain.robot().joints.iter().filter(|j| j.is_actuated()).collect();
-    let names: Vec<String> = joints.iter().map(|j| j.name.clone()).collect();
-    let mut rng = Rand64::new(34);
-    let states: Vec<Vec<f64>> = (0..40)
-        .map(|_| {
-            joints
-                .iter()
-                .map(|j| {
-                    let (lo, hi) = if j.kind == JointKind::Continuous { (-3.1, 3.1) } else { (j.limits[0], j.limits[1]) };
-                    lo + (hi - lo) * rng.rand_float()
-                })
-                .collect()
-        })
-        .collect();
+    std::fs::write(&twin_urdf, common::arm_with_tray()).unwrap();
+    let (names, states) = common::random_arm_states(40, 34);
     let lines: Vec<Value> = states.iter().map(|p| json!({"name": names, "position": p})).collect();
     let cli = common::check_json(&dir, "twin", &lines, &["--robot", twin_urdf.to_str().unwrap(), "--srdf", twin_srdf_file.to_str().unwrap()]);
     let with_tray = cli.iter().filter(|r| r["contacts"].as_array().unwrap().iter().any(|c| c["link_name"] == "tray" || c["object_name"] == "tray")).count();

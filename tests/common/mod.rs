@@ -8,10 +8,13 @@ use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, Stdio};
 
+mod bundled_arm;
 pub mod netns;
 mod scaffold;
 
 // Each test binary uses some of these.
+#[allow(unused_imports)]
+pub use self::bundled_arm::{arm_srdfs, arm_with_tray, random_arm_states};
 #[allow(unused_imports)]
 pub use self::scaffold::{emptied, mesh_area, scratch_dir, scratch_subdir, thin_area, topology, topology_area, write_le, LeBytes};
 
