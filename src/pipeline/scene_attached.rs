@@ -4,15 +4,11 @@
 
 use super::collision_object::object_to_add;
 use super::planning_world::{AddObject, PlanningWorld};
-use super::scene_state::{AttachedObject, FrameContext, SceneState};
+use super::scene_state::{refuse, AttachedObject, FrameContext, SceneState};
 use super::skip::{Skip, SkipCause};
 use crate::checker::WorldShape;
 use crate::math::Pose;
 use crate::msgs::planning_scene::{AttachedCollisionObject, CollisionObject};
-
-fn refuse(cause: SkipCause, message: String) -> Skip {
-    Skip { cause, message }
-}
 
 impl SceneState {
     /// One `moveit_msgs/AttachedCollisionObject`, applied to this scene (unchanged on error).
@@ -52,24 +48,23 @@ impl SceneState {
         let link_pose = Self::link_pose(ctx, &msg.link_name, what)?;
         let to_link = link_pose.inverse();
         let has_geometry = !(object.primitives.is_empty() && object.meshes.is_empty() && object.planes.is_empty());
-        let shapes: Vec<(WorldShape, Pose)> = if has_geometry {
+        // With geometry, the object placed by the pose rules of a world object (a lone shape and
+        // an empty pose); without, the world object of that id. Either way a world object of the
+        // id is removed, as MoveIt does: the object is now held.
+        let mut placed: PlanningWorld<WorldShape> = PlanningWorld::default();
+        let source = if has_geometry {
             let header = self.frame(ctx, &object.header.frame_id, id)?;
             let add = object_to_add(object, header).map_err(|e| refuse(SkipCause::SceneGeometry, format!("attached {e}")))?;
-            // The object's pose rules (a lone shape and an empty pose) as for a world object.
-            let mut placed: PlanningWorld<WorldShape> = PlanningWorld::default();
             placed.add(id, add).map_err(|e| refuse(SkipCause::SceneGeometry, format!("attached {e}")))?;
-            let o = placed.get(id).ok_or_else(|| refuse(SkipCause::SceneGeometry, format!("{what}: no shapes")))?;
-            // MoveIt removes a world object of the same id: the object is now held.
-            let _ = self.world.remove(id);
-            o.shapes.iter().map(|(s, p)| (s.clone(), to_link * o.pose * *p)).collect()
+            &placed
         } else {
-            let Some(o) = self.world.get(id) else {
-                return Err(refuse(SkipCause::SceneUnknownId, format!("{what}: no geometry given and no world object '{id}' to attach")));
-            };
-            let shapes = o.shapes.iter().map(|(s, p)| (s.clone(), to_link * o.pose * *p)).collect();
-            let _ = self.world.remove(id);
-            shapes
+            &self.world
         };
+        let Some(o) = source.get(id) else {
+            return Err(refuse(SkipCause::SceneUnknownId, format!("{what}: no geometry given and no world object '{id}' to attach")));
+        };
+        let shapes: Vec<(WorldShape, Pose)> = o.shapes.iter().map(|(s, p)| (s.clone(), to_link * o.pose * *p)).collect();
+        let _ = self.world.remove(id);
         match self.attached.get_mut(id) {
             Some(a) if object.operation == CollisionObject::APPEND && a.link == msg.link_name => {
                 a.shapes.extend(shapes);

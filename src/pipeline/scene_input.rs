@@ -36,13 +36,7 @@ pub(crate) struct BuiltScene {
 impl ScenePlan {
     /// Builds the new scene's cells (those the cache lacks) and its checker.
     pub(crate) fn build(mut self) -> BuiltScene {
-        let objects = self.next.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
-        let attached = self.next.attached_specs();
-        let checker = self
-            .base
-            .with_scene(objects, &attached, self.next.matrix.as_ref(), &mut self.bodies)
-            .map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() });
-        drop(attached);
+        let checker = self.next.checker_on(&self.base, &mut self.bodies).map_err(|e| Skip { cause: SkipCause::SceneGeometry, message: e.to_string() });
         BuiltScene { next: self.next, checker, bodies: self.bodies }
     }
 }

@@ -9,7 +9,7 @@
 use super::collision_object::{object_to_add, pose_of, MAX_OBJECT_TRIANGLES};
 use super::planning_world::{PlanningWorld, WorldError};
 use super::skip::{Skip, SkipCause};
-use crate::checker::{Attached, Checker, CollisionMatrix, WorldShape};
+use crate::checker::{Attached, BodyCache, Checker, CheckerError, CollisionMatrix, WorldShape};
 use crate::math::Pose;
 use crate::msgs::planning_scene::{
     AllowedCollisionEntry, AllowedCollisionMatrix, AttachedCollisionObject, CollisionObject, LinkPadding, LinkScale, MeshTriangle, Plane, PlanningScene,
@@ -51,7 +51,7 @@ pub(super) struct FrameContext<'a> {
     pub robot_link: &'a dyn Fn(usize) -> Result<Pose, String>,
 }
 
-fn refuse(cause: SkipCause, message: String) -> Skip {
+pub(super) fn refuse(cause: SkipCause, message: String) -> Skip {
     Skip { cause, message }
 }
 
@@ -63,6 +63,13 @@ impl SceneState {
     /// The attached objects as the checker takes them.
     pub(super) fn attached_specs(&self) -> Vec<Attached<'_>> {
         self.attached.iter().map(|(id, a)| Attached { id, link: &a.link, shapes: &a.shapes, touch_links: &a.touch_links }).collect()
+    }
+
+    /// `base` (its environment and robot) with this scene's objects, attached objects and matrix,
+    /// mesh cells from `cache` when it holds them.
+    pub(super) fn checker_on(&self, base: &Checker, cache: &mut BodyCache) -> Result<Checker, CheckerError> {
+        let objects = self.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
+        base.with_scene(objects, &self.attached_specs(), self.matrix.as_ref(), cache)
     }
 
     /// The pose in the world of `frame` (a leading `/` ignored): the world frame, a fixed frame,

@@ -371,8 +371,7 @@ impl Pipeline {
         let checker = if self.scene.is_empty() {
             checker
         } else {
-            let objects = self.scene.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
-            match checker.with_scene(objects, &self.scene.attached_specs(), self.scene.matrix.as_ref(), &mut self.bodies) {
+            match self.scene.checker_on(&checker, &mut self.bodies) {
                 Ok(with) => with,
                 Err(e) => {
                     let (world, attached) = (self.scene.world.len(), self.scene.attached.len());
