@@ -56,8 +56,9 @@ pub(super) fn refuse(cause: SkipCause, message: String) -> Skip {
 }
 
 impl SceneState {
+    /// Nothing here changes the checker: no objects, no attached objects, no matrix.
     pub(super) fn is_empty(&self) -> bool {
-        self.world.len() == 0 && self.attached.is_empty()
+        self.world.len() == 0 && self.attached.is_empty() && self.matrix.is_none()
     }
 
     /// The attached objects as the checker takes them.

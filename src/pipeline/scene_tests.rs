@@ -334,7 +334,7 @@ fn the_allowed_collision_matrix_travels_and_applies() {
     let (f, s) = (edited.entry_names.iter().position(|n| n == "forearm_link").unwrap(), edited.entry_names.iter().position(|n| n == "scan").unwrap());
     edited.entry_values[f].enabled[s] = true;
     edited.entry_values[s].enabled[f] = true;
-    p.planning_scene(&diff(edited)).unwrap();
+    p.planning_scene(&diff(edited.clone())).unwrap();
     let after = reports(&p);
     assert!(after.iter().all(|(_, c)| !c.iter().any(|(l, o)| l == "forearm_link" && o == "scan")));
     let changed = before.iter().zip(&after).filter(|(a, b)| a != b).count();
@@ -342,6 +342,25 @@ fn the_allowed_collision_matrix_travels_and_applies() {
         changed > 0 && before.iter().zip(&after).all(|(a, b)| a == b || a.1.iter().any(|(l, o)| l == "forearm_link" && o == "scan")),
         "only the allowed pair changes"
     );
+    // A matrix alone (no object in the scene) stays in force across new parameters.
+    let mut alone = PlanningScene { is_diff: false, ..diff(acm.clone()) };
+    alone.allowed_collision_matrix = {
+        let mut m = acm.clone();
+        let (a, b) = pairs[0];
+        let (na, nb) = (&p.checker().targets()[a].name, &p.checker().targets()[b].name);
+        let (ia, ib) = (m.entry_names.iter().position(|n| n == na).unwrap(), m.entry_names.iter().position(|n| n == nb).unwrap());
+        m.entry_values[ia].enabled[ib] = true;
+        m.entry_values[ib].enabled[ia] = true;
+        m
+    };
+    p.planning_scene(&alone).unwrap();
+    assert!(!p.checker().self_pairs().pairs.contains(&pairs[0]));
+    p.set_params(Params::default()).unwrap();
+    assert!(!p.checker().self_pairs().pairs.contains(&pairs[0]), "the scene's matrix survives a parameter change");
+    p.planning_scene(&PlanningScene::default()).unwrap();
+    p.collision_object(&sheet_at(0.2, -0.3, 0.3)).unwrap();
+    p.planning_scene(&diff(edited)).unwrap();
+    assert_eq!(reports(&p), after);
     // A bad matrix is refused whole.
     let mut bad = acm.clone();
     let _ = bad.entry_values.pop();
