@@ -63,6 +63,8 @@ pub struct Checker {
     /// The environment's links by name, with their poses in the world: frames a planning-scene
     /// object may be given in.
     pub(super) environment_frames: Arc<BTreeMap<String, crate::math::Pose>>,
+    /// The padding and scale a planning scene set for robot links.
+    pub(super) link_sizes: Arc<super::link_sizes::LinkSizes>,
 }
 
 impl Checker {

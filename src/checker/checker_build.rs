@@ -5,7 +5,7 @@
 use super::checker::{BuildSummary, Checker};
 use super::checker_error::CheckerError;
 use super::geometry_shapes::{primitive_shape, MeshCache};
-use super::link_targets::LinkTargets;
+use super::link_targets::{LinkTargets, PartSource};
 use super::self_pairs::SelfPairs;
 use crate::collision::{ConvexHull, ObjectBody, Scene, TargetShape};
 use crate::math::pose_from_isometry;
@@ -123,6 +123,7 @@ impl Checker {
             robot_targets,
             environment_objects: scene_objects,
             environment_frames: Arc::new(environment_frames),
+            link_sizes: Arc::default(),
         })
     }
 
@@ -175,6 +176,7 @@ impl Checker {
             robot_targets: self.robot_targets,
             environment_objects: self.environment_objects,
             environment_frames: Arc::clone(&self.environment_frames),
+            link_sizes: Arc::clone(&self.link_sizes),
         }
     }
 
@@ -275,36 +277,37 @@ fn robot_targets(params: &Params, robot: &RobotModel, cache: &mut MeshCache, fil
             continue;
         }
         let padding = params.padding_of(&link.name);
-        let mut parts = Vec::new();
+        let (mut parts, mut sources) = (Vec::new(), Vec::new());
         for g in &link.geometry {
-            parts.push((link_part(&g.spec, padding, cache, file, &link.name)?, pose_from_isometry(&g.origin)));
+            let source = link_source(&g.spec, cache, file, &link.name)?;
+            let shape = source.sized(1.0, padding).ok_or_else(|| {
+                let (what, message) = match &g.spec {
+                    GeometrySpec::Mesh { path, .. } => (format!("mesh {}", path.display()), "padding failed"),
+                    spec => (format!("{spec:?}"), "not a usable convex shape"),
+                };
+                CheckerError::Geometry { file: file.to_owned(), link: link.name.clone(), what, message: message.into() }
+            })?;
+            parts.push((shape, pose_from_isometry(&g.origin)));
+            sources.push(source);
         }
-        targets.push(LinkTargets { link: li, name: link.name.clone(), parts });
+        targets.push(LinkTargets { link: li, name: link.name.clone(), parts, sources: sources.into() });
     }
     Ok(targets)
 }
 
-/// One geometry of robot link `link` as a target grown by `padding`: a mesh as its convex hull.
-fn link_part(spec: &GeometrySpec, padding: f64, cache: &mut MeshCache, file: &str, link: &str) -> Result<TargetShape, CheckerError> {
+/// What one geometry of robot link `link` is grown from: a mesh as its convex hull.
+fn link_source(spec: &GeometrySpec, cache: &mut MeshCache, file: &str, link: &str) -> Result<PartSource, CheckerError> {
     match spec {
         GeometrySpec::Mesh { path, scale } => {
             let data = cache.get(path, *scale).map_err(|error| CheckerError::Mesh { file: file.to_owned(), link: link.to_owned(), error })?;
-            let geo = |message: &str| CheckerError::Geometry {
+            PartSource::mesh(&data).ok_or_else(|| CheckerError::Geometry {
                 file: file.to_owned(),
                 link: link.to_owned(),
                 what: format!("mesh {}", path.display()),
-                message: message.into(),
-            };
-            let hull = ConvexHull::from_points(&data.vertices).ok_or_else(|| geo("its convex hull is flat or empty"))?;
-            let hull = hull.padded(padding).ok_or_else(|| geo("padding failed"))?;
-            Ok(TargetShape::Polytope(Arc::new(hull)))
+                message: "its convex hull is flat or empty".into(),
+            })
         }
-        spec => primitive_shape(spec, padding).ok_or_else(|| CheckerError::Geometry {
-            file: file.to_owned(),
-            link: link.to_owned(),
-            what: format!("{spec:?}"),
-            message: "not a usable convex shape".into(),
-        }),
+        spec => Ok(PartSource::Primitive(spec.clone())),
     }
 }
 

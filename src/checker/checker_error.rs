@@ -32,6 +32,10 @@ pub enum CheckerError {
         /// Why.
         message: String,
     },
+    /// A planning scene's `link_padding` / `link_scale` that leave a robot link without a usable
+    /// shape: the scene in force stays.
+    #[error("planning scene: link_padding / link_scale: {0}")]
+    LinkSize(String),
     /// Building panicked (a defect, in this crate or a dependency): contained, so the robot in
     /// use stays.
     #[error("building the checker failed: {0}")]

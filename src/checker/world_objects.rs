@@ -4,6 +4,7 @@ use super::checker::{BuildSummary, Checker};
 use super::checker_build::{allowed_matrix, moving_joints};
 use super::checker_error::CheckerError;
 use super::collision_matrix::CollisionMatrix;
+use super::link_sizes::{scaled_shape, LinkSizes};
 use super::link_targets::LinkTargets;
 use super::world_shapes::{add_world_object, attached_part, BodyCache, WorldShape};
 use crate::collision::Scene;
@@ -35,19 +36,21 @@ impl Checker {
         objects: impl IntoIterator<Item = (&'a str, &'a Pose, &'a [(WorldShape, Pose)])>,
         cache: &mut BodyCache,
     ) -> Result<Checker, CheckerError> {
-        self.with_scene(objects, &[], None, cache)
+        self.with_scene(objects, &[], None, &LinkSizes::default(), cache)
     }
 
     /// [`Checker::with_world`], with `attached` objects on the robot's links (those of an earlier
-    /// call replaced), and the planning scene's allowed collision `matrix` in place of the SRDF's
-    /// (see [`Checker::with_targets`]).
+    /// call replaced), the planning scene's allowed collision `matrix` in place of the SRDF's
+    /// (see [`Checker::with_targets`]) and its link `sizes` (see [`LinkSizes`]).
     pub(crate) fn with_scene<'a>(
         &self,
         objects: impl IntoIterator<Item = (&'a str, &'a Pose, &'a [(WorldShape, Pose)])>,
         attached: &[Attached],
         matrix: Option<&CollisionMatrix>,
+        sizes: &LinkSizes,
         cache: &mut BodyCache,
     ) -> Result<Checker, CheckerError> {
+        let robot = self.robot_targets_sized(sizes).map_err(CheckerError::LinkSize)?;
         let environment = &self.scene.objects()[..self.environment_objects];
         let mut added = Scene::new();
         for (id, pose, shapes) in objects {
@@ -62,23 +65,33 @@ impl Checker {
         }
         cache.keep_used();
         let scene = self.scene.prefix_with(self.environment_objects, &added);
-        self.with_targets(Arc::new(scene), attached, matrix)
+        let sizes = (*sizes != *self.link_sizes).then(|| Arc::new(sizes.clone()));
+        self.with_targets(Arc::new(scene), robot, sizes, attached, matrix)
     }
 
     /// This checker with `attached` objects on the robot's links in place of its own (a
     /// `check_state_validity` request's), the scene and `matrix` kept.
     pub(crate) fn with_attached(&self, attached: &[Attached], matrix: Option<&CollisionMatrix>) -> Result<Checker, CheckerError> {
-        self.with_targets(Arc::clone(&self.scene), attached, matrix)
+        self.with_targets(Arc::clone(&self.scene), self.targets[..self.robot_targets].to_vec(), None, attached, matrix)
     }
 
-    /// The targets of the robot's links and of `attached`, against `scene`. Without a `matrix`
+    /// The targets of the robot's links (`robot`, sized by `sizes` when they are new) and of
+    /// `attached`, against `scene`. Without a `matrix`
     /// the robot's pairs are the SRDF's (or the default reasoning's); with one, every pair it
     /// does not allow is checked, and a link and an object it allows are not. `allowed_collisions`
     /// allows on top of either; an attached object never meets its own link or touch links.
-    fn with_targets(&self, scene: Arc<Scene>, attached: &[Attached], matrix: Option<&CollisionMatrix>) -> Result<Checker, CheckerError> {
-        let mut targets = self.targets[..self.robot_targets].to_vec();
+    fn with_targets(
+        &self,
+        scene: Arc<Scene>,
+        robot: Vec<LinkTargets>,
+        sizes: Option<Arc<LinkSizes>>,
+        attached: &[Attached],
+        matrix: Option<&CollisionMatrix>,
+    ) -> Result<Checker, CheckerError> {
+        let sizes = sizes.unwrap_or_else(|| Arc::clone(&self.link_sizes));
+        let mut targets = robot;
         for a in attached {
-            targets.extend(self.attached_target(a)?);
+            targets.extend(self.attached_target(a, &sizes)?);
         }
         let mut allowed = allowed_matrix(&self.params, &targets, &scene);
         let mut pairs = self.self_pairs.clone();
@@ -108,7 +121,9 @@ impl Checker {
         }
         let mut checker = self.rebuilt(scene, allowed, pairs);
         checker.srdf_pairs = matrix.map(|_| srdf_pairs);
-        if targets.len() != self.robot_targets || self.targets.len() != self.robot_targets {
+        let resized = !Arc::ptr_eq(&sizes, &self.link_sizes);
+        checker.link_sizes = sizes;
+        if resized || targets.len() != self.robot_targets || self.targets.len() != self.robot_targets {
             // Motion bounds and the joints a state must give follow the targets.
             checker.moving = moving_joints(&self.robot, &targets);
             checker.motion = std::sync::OnceLock::new();
@@ -118,8 +133,10 @@ impl Checker {
     }
 
     /// The target of an attached object (none when `checked_links` leaves its id out), its
-    /// parts as a robot link's: a mesh as the hull of its vertices, grown by `padding` for its id.
-    fn attached_target(&self, a: &Attached) -> Result<Option<LinkTargets>, CheckerError> {
+    /// parts as a robot link's: a mesh as the hull of its vertices, grown by `padding` for its id;
+    /// when the scene's `sizes` set a padding or scale for its link, those (as MoveIt sizes an
+    /// attached body as its link).
+    fn attached_target(&self, a: &Attached, sizes: &LinkSizes) -> Result<Option<LinkTargets>, CheckerError> {
         let refuse = |message: String| CheckerError::WorldObject { id: a.id.to_owned(), message };
         let link = self.robot.link(a.link).ok_or_else(|| refuse(format!("link '{}' is not a link of the robot", a.link)))?;
         if self.robot.link(a.id).is_some() || self.environment_frames.contains_key(a.id) {
@@ -128,14 +145,17 @@ impl Checker {
         if !self.params.is_checked(a.id) {
             return Ok(None);
         }
-        let padding = self.params.padding_of(a.id);
+        let padding = sizes.padding.get(a.link).copied().unwrap_or_else(|| self.params.padding_of(a.id));
+        let scale = sizes.scale.get(a.link).copied().unwrap_or(1.0);
         let parts = a
             .shapes
             .iter()
             .enumerate()
-            .map(|(k, (shape, pose))| attached_part(shape, padding).map(|s| (s, *pose)).ok_or_else(|| refuse(format!("shape {k}: not a usable convex shape"))))
+            .map(|(k, (shape, pose))| {
+                attached_part(&scaled_shape(shape, scale), padding).map(|s| (s, *pose)).ok_or_else(|| refuse(format!("shape {k}: not a usable convex shape")))
+            })
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Some(LinkTargets { link, name: a.id.to_owned(), parts }))
+        Ok(Some(LinkTargets { link, name: a.id.to_owned(), parts, sources: Arc::new([]) }))
     }
 }
 

@@ -40,4 +40,6 @@ pub(crate) use self::validity::ValidityJob;
 #[cfg(test)]
 mod pipeline_tests;
 #[cfg(test)]
+mod scene_size_tests;
+#[cfg(test)]
 mod scene_tests;

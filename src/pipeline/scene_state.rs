@@ -9,7 +9,7 @@
 use super::collision_object::{object_to_add, pose_of, MAX_OBJECT_TRIANGLES};
 use super::planning_world::{PlanningWorld, WorldError};
 use super::skip::{Skip, SkipCause};
-use crate::checker::{Attached, BodyCache, Checker, CheckerError, CollisionMatrix, WorldShape};
+use crate::checker::{Attached, BodyCache, Checker, CheckerError, CollisionMatrix, LinkSizes, WorldShape};
 use crate::math::Pose;
 use crate::msgs::planning_scene::{
     AllowedCollisionEntry, AllowedCollisionMatrix, AttachedCollisionObject, CollisionObject, LinkPadding, LinkScale, MeshTriangle, Plane, PlanningScene,
@@ -32,6 +32,8 @@ pub(crate) struct SceneState {
     pub(super) fixed_frames: BTreeMap<String, Pose>,
     /// The allowed collision matrix a scene message gave, in place of the SRDF's.
     pub(super) matrix: Option<CollisionMatrix>,
+    /// `link_padding` and `link_scale` a scene message gave for robot links.
+    pub(super) sizes: LinkSizes,
 }
 
 /// An object attached to a robot link: it moves with the link.
@@ -56,9 +58,9 @@ pub(super) fn refuse(cause: SkipCause, message: String) -> Skip {
 }
 
 impl SceneState {
-    /// Nothing here changes the checker: no objects, no attached objects, no matrix.
+    /// Nothing here changes the checker: no objects, no attached objects, no matrix, no link sizes.
     pub(super) fn is_empty(&self) -> bool {
-        self.world.len() == 0 && self.attached.is_empty() && self.matrix.is_none()
+        self.world.len() == 0 && self.attached.is_empty() && self.matrix.is_none() && self.sizes.is_empty()
     }
 
     /// The attached objects as the checker takes them.
@@ -66,11 +68,11 @@ impl SceneState {
         self.attached.iter().map(|(id, a)| Attached { id, link: &a.link, shapes: &a.shapes, touch_links: &a.touch_links }).collect()
     }
 
-    /// `base` (its environment and robot) with this scene's objects, attached objects and matrix,
-    /// mesh cells from `cache` when it holds them.
+    /// `base` (its environment and robot) with this scene's objects, attached objects, matrix and
+    /// link sizes, mesh cells from `cache` when it holds them.
     pub(super) fn checker_on(&self, base: &Checker, cache: &mut BodyCache) -> Result<Checker, CheckerError> {
         let objects = self.world.objects().map(|(id, o)| (id, &o.pose, o.shapes.as_slice()));
-        base.with_scene(objects, &self.attached_specs(), self.matrix.as_ref(), cache)
+        base.with_scene(objects, &self.attached_specs(), self.matrix.as_ref(), &self.sizes, cache)
     }
 
     /// The pose in the world of `frame` (a leading `/` ignored): the world frame, a fixed frame,
@@ -196,16 +198,17 @@ impl SceneState {
     }
 
     /// A `PlanningScene`, a difference (`is_diff`) or the whole scene, in MoveIt's order: the
-    /// allowed collision matrix (one with entries replaces the one in force), fixed frames, the
+    /// allowed collision matrix (one with entries replaces the one in force), fixed frames, link
+    /// padding and scale (each entry replaces the link's; a whole scene's replace them all), the
     /// robot state's attached objects (all replaced when `robot_state.is_diff` is false), world
-    /// objects. Link padding and scale other than those in force refuse it whole (not supported
-    /// yet: ignoring them would check against a scene the planner does not have). The robot state's joint positions are not used: states come from
-    /// `joint_states`.
+    /// objects. The robot state's joint positions are not used: states come from `joint_states`.
     pub(super) fn apply_scene(&mut self, ctx: &FrameContext, msg: &PlanningScene) -> Result<(), Skip> {
-        padding_and_scale_in_force(ctx.checker, msg)?;
+        let (padding, scale) = link_sizes_of(ctx.checker, msg)?;
         if !msg.is_diff {
             *self = SceneState::default();
         }
+        self.sizes.padding.extend(padding);
+        self.sizes.scale.extend(scale);
         let acm = &msg.allowed_collision_matrix;
         if !acm.entry_names.is_empty() || !acm.default_entry_names.is_empty() {
             self.matrix = Some(matrix_of(acm)?);
@@ -281,8 +284,8 @@ impl SceneState {
         }
         if components & PlanningSceneComponents::LINK_PADDING_AND_SCALING != 0 {
             let robot = checker.robot();
-            scene.link_padding = robot.links.iter().map(|l| LinkPadding { link_name: l.name.clone(), padding: checker.params().padding_of(&l.name) }).collect();
-            scene.link_scale = robot.links.iter().map(|l| LinkScale { link_name: l.name.clone(), scale: 1.0 }).collect();
+            scene.link_padding = robot.links.iter().map(|l| LinkPadding { link_name: l.name.clone(), padding: checker.link_padding(&l.name) }).collect();
+            scene.link_scale = robot.links.iter().map(|l| LinkScale { link_name: l.name.clone(), scale: checker.link_scale(&l.name) }).collect();
         }
         if components & PlanningSceneComponents::TRANSFORMS != 0 {
             scene.fixed_frame_transforms = self
@@ -295,33 +298,44 @@ impl SceneState {
     }
 }
 
-/// `link_padding` and `link_scale` as the node has them (the `padding` parameter's, scale 1), as
-/// `get_planning_scene` gives them back: accepted; any other value refuses the message (a scene
-/// cannot change them yet: checking with other sizes than the planner's would not be the
-/// planner's world). Names that are no robot link are ignored, as MoveIt ignores them.
-fn padding_and_scale_in_force(checker: &Checker, msg: &PlanningScene) -> Result<(), Skip> {
+/// Largest `link_scale` taken (a link scaled further is no robot a planner means).
+pub(crate) const MAX_LINK_SCALE: f64 = 1e3;
+
+/// The message's `link_padding` and `link_scale` for robot links (names that are no robot link
+/// are ignored: there is nothing to size), or why a value cannot be used: a padding that is not
+/// from 0 to 1e4 m (the `padding` parameter's range), a scale that is not above 0 and at most
+/// [`MAX_LINK_SCALE`] (MoveIt refuses both too).
+#[allow(clippy::type_complexity)]
+fn link_sizes_of(checker: &Checker, msg: &PlanningScene) -> Result<(Vec<(String, f64)>, Vec<(String, f64)>), Skip> {
     let robot = checker.robot();
-    for p in msg.link_padding.iter().filter(|p| robot.link(&p.link_name).is_some()) {
-        let in_force = checker.params().padding_of(&p.link_name);
-        if (p.padding - in_force).abs() > 1e-12 {
+    let hi = crate::limits::LENGTH_RANGE[1];
+    let mut padding = Vec::new();
+    for (k, p) in msg.link_padding.iter().enumerate().filter(|(_, p)| robot.link(&p.link_name).is_some()) {
+        if !(p.padding >= 0.0 && p.padding <= hi) {
             return Err(refuse(
-                SkipCause::SceneUnsupported,
+                SkipCause::SceneGeometry,
                 format!(
-                    "planning scene: link_padding: '{}' {} differs from the padding in force {in_force} (set by the padding parameter; a scene cannot change it yet); the scene is left as it was",
+                    "planning scene: link_padding[{k}] ('{}'): padding {:?} must be from 0 to {hi:e} m; the scene is left as it was",
                     p.link_name, p.padding
                 ),
             ));
         }
+        padding.push((p.link_name.clone(), p.padding));
     }
-    for l in msg.link_scale.iter().filter(|l| robot.link(&l.link_name).is_some()) {
-        if (l.scale - 1.0).abs() > 1e-12 {
+    let mut scale = Vec::new();
+    for (k, l) in msg.link_scale.iter().enumerate().filter(|(_, l)| robot.link(&l.link_name).is_some()) {
+        if !(l.scale > 0.0 && l.scale <= MAX_LINK_SCALE) {
             return Err(refuse(
-                SkipCause::SceneUnsupported,
-                format!("planning scene: link_scale: '{}' {}: only 1 is supported yet; the scene is left as it was", l.link_name, l.scale),
+                SkipCause::SceneGeometry,
+                format!(
+                    "planning scene: link_scale[{k}] ('{}'): scale {:?} must be above 0 and at most {MAX_LINK_SCALE}; the scene is left as it was",
+                    l.link_name, l.scale
+                ),
             ));
         }
+        scale.push((l.link_name.clone(), l.scale));
     }
-    Ok(())
+    Ok((padding, scale))
 }
 
 /// The message's matrix, or why it cannot be read.

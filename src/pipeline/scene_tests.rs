@@ -9,9 +9,10 @@ use crate::model::Params;
 use crate::msgs::planning_scene::{CollisionObject, MeshTriangle, PlanningScene, PlanningSceneComponents, ShapeMesh, SolidPrimitive};
 use crate::msgs::{Header, JointState, Point, PoseMsg, Quaternion, Time};
 
-const ARM: [&str; 7] = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
+pub(super) const ARM: [&str; 7] =
+    ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint", "finger_left_joint"];
 
-fn at(x: f64, y: f64, z: f64) -> PoseMsg {
+pub(super) fn at(x: f64, y: f64, z: f64) -> PoseMsg {
     PoseMsg { position: Point { x, y, z }, orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 } }
 }
 
@@ -23,7 +24,7 @@ fn sheet() -> ShapeMesh {
     }
 }
 
-fn object(frame: &str, id: &str, operation: u8) -> CollisionObject {
+pub(super) fn object(frame: &str, id: &str, operation: u8) -> CollisionObject {
     CollisionObject {
         header: Header { stamp: Time::default(), frame_id: frame.into() },
         id: id.into(),
@@ -48,6 +49,22 @@ fn reports(p: &Pipeline) -> Vec<(bool, Vec<(String, String)>)> {
             (r.in_collision, r.contacts.into_iter().map(|c| (c.link_name, c.object_name)).collect())
         })
         .collect()
+}
+
+/// An SRDF (without its closing tag) that disables the pairs `plain`'s default reasoning allows,
+/// so that a twin robot with other geometry is checked with the same pairs.
+pub(super) fn explicit_srdf(plain: &crate::checker::Checker) -> String {
+    use std::fmt::Write as _;
+    let targets = plain.targets();
+    let mut srdf = String::from("<robot name=\"tc_arm\">");
+    for a in 0..targets.len() {
+        for b in a + 1..targets.len() {
+            if !plain.self_pairs().pairs.contains(&(a, b)) {
+                let _ = write!(srdf, "<disable_collisions link1=\"{}\" link2=\"{}\" reason=\"Default\"/>", targets[a].name, targets[b].name);
+            }
+        }
+    }
+    srdf
 }
 
 /// A MOVE, and `move_group`'s full re-ADD of the same geometry at a new pose, build no cells:
@@ -153,13 +170,6 @@ fn scenes_apply_whole_and_travel_back() {
     let msg = p.planning_scene_message(all, Time::default());
     assert_eq!(msg.world.collision_objects.len(), 2);
     assert_eq!(msg.link_padding.len(), p.checker().robot().links.len(), "padding and scale of every link, as in force");
-    // Other padding or scale than in force: refused whole (not supported yet).
-    let mut padded = msg.clone();
-    padded.link_padding[1].padding += 0.05;
-    assert_eq!(p.planning_scene(&padded).unwrap_err().cause, SkipCause::SceneUnsupported);
-    let mut scaled = msg.clone();
-    scaled.link_scale[1].scale = 1.1;
-    assert!(p.planning_scene(&scaled).unwrap_err().message.contains("link_scale"));
     let mut fresh = Pipeline::new(Params::default()).unwrap();
     fresh.collision_object(&sheet_at(9.0, 9.0, 9.0)).unwrap();
     fresh.planning_scene(&msg).unwrap();
@@ -188,20 +198,9 @@ fn an_attached_object_is_checked_as_a_fixed_child_link() {
     use crate::checker::{Checker, ObjectType};
     use crate::model::{PackageResolver, RobotModel};
     use crate::msgs::planning_scene::AttachedCollisionObject;
-    use std::fmt::Write as _;
     let dir = std::env::temp_dir().join(format!("tc_attached_twin_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    // An SRDF that disables what the default reasoning allows, so both sides use one matrix.
-    let plain = Checker::from_params(Params::default()).unwrap();
-    let targets = plain.targets();
-    let mut srdf = String::from("<robot name=\"tc_arm\">");
-    for a in 0..targets.len() {
-        for b in a + 1..targets.len() {
-            if !plain.self_pairs().pairs.contains(&(a, b)) {
-                let _ = write!(srdf, "<disable_collisions link1=\"{}\" link2=\"{}\" reason=\"Default\"/>", targets[a].name, targets[b].name);
-            }
-        }
-    }
+    let srdf = explicit_srdf(&Checker::from_params(Params::default()).unwrap());
     let touch = ["gripper_link", "finger_left_link", "finger_right_link"];
     let twin_srdf = touch.iter().fold(srdf.clone(), |s, l| s + &format!("<disable_collisions link1=\"tray\" link2=\"{l}\" reason=\"Touch\"/>")) + "</robot>";
     let srdf = srdf + "</robot>";

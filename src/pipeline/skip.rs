@@ -32,7 +32,7 @@ pub enum SkipCause {
     SceneFrame,
     /// A planning-scene object with a field that cannot be used: non-finite vertices or poses,
     /// out-of-range triangle indices, shape and pose arrays of different lengths, an unknown
-    /// shape type, wrong dimensions.
+    /// shape type, wrong dimensions, a link padding or scale out of range.
     SceneGeometry,
     /// A `REMOVE` or `MOVE` of an id the scene does not hold.
     SceneUnknownId,
@@ -42,15 +42,13 @@ pub enum SkipCause {
     SceneId,
     /// Past the scene's bounds: triangles per object or in all, objects.
     SceneBounds,
-    /// A part of a planning-scene message not supported yet (the message is refused whole).
-    SceneUnsupported,
     /// An octomap in a planning-scene message: refused (the rest of the message applies).
     SceneOctomap,
 }
 
 impl SkipCause {
     /// Every cause, in the order reports list them.
-    pub const ALL: [SkipCause; 18] = [
+    pub const ALL: [SkipCause; 17] = [
         SkipCause::Undecodable,
         SkipCause::Lengths,
         SkipCause::NonFinite,
@@ -67,7 +65,6 @@ impl SkipCause {
         SkipCause::SceneOperation,
         SkipCause::SceneId,
         SkipCause::SceneBounds,
-        SkipCause::SceneUnsupported,
         SkipCause::SceneOctomap,
     ];
 
@@ -95,7 +92,6 @@ impl SkipCause {
             SkipCause::SceneOperation => "scene_operation",
             SkipCause::SceneId => "scene_id",
             SkipCause::SceneBounds => "scene_bounds",
-            SkipCause::SceneUnsupported => "scene_unsupported",
             SkipCause::SceneOctomap => "scene_octomap",
         }
     }
