@@ -128,6 +128,19 @@ pub fn planning_scene_apply(pipeline: &mut Pipeline, data: &[u8]) -> bool {
 /// The CDR bytes of a `moveit_msgs/CollisionObject` in `world` with `operation` (0 ADD, 1 REMOVE,
 /// 2 APPEND, 3 MOVE), its pose (x, y, z, qx, qy, qz, qw) and, if given, one mesh.
 pub fn collision_object_cdr(id: &str, operation: u8, pose: [f64; 7], mesh: Option<(&[crate::math::Vector], &[[u32; 3]])>) -> Vec<u8> {
+    encode_cdr_le(&collision_object(id, operation, pose, mesh))
+}
+
+/// The CDR bytes of a `moveit_msgs/srv/ApplyPlanningScene` request as a client on the enhanced
+/// mapping (Fast DDS) sends it: a difference whose world holds the object of
+/// [`collision_object_cdr`].
+pub fn apply_planning_scene_cdr(id: &str, operation: u8, pose: [f64; 7], mesh: Option<(&[crate::math::Vector], &[[u32; 3]])>) -> Vec<u8> {
+    use crate::msgs::planning_scene::{ApplyPlanningSceneRequest, PlanningSceneWorld};
+    let world = PlanningSceneWorld { collision_objects: vec![collision_object(id, operation, pose, mesh)], ..Default::default() };
+    encode_cdr_le(&ApplyPlanningSceneRequest { scene: PlanningScene { is_diff: true, world, ..Default::default() } })
+}
+
+fn collision_object(id: &str, operation: u8, pose: [f64; 7], mesh: Option<(&[crate::math::Vector], &[[u32; 3]])>) -> CollisionObject {
     use crate::msgs::planning_scene::{MeshTriangle, ShapeMesh};
     use crate::msgs::{Header, Point, PoseMsg, Quaternion};
     let [x, y, z, qx, qy, qz, qw] = pose;
@@ -137,15 +150,14 @@ pub fn collision_object_cdr(id: &str, operation: u8, pose: [f64; 7], mesh: Optio
             triangles: t.iter().map(|t| MeshTriangle { vertex_indices: *t }).collect(),
         }]
     });
-    let msg = CollisionObject {
+    CollisionObject {
         header: Header { frame_id: "world".into(), ..Default::default() },
         pose: PoseMsg { position: Point { x, y, z }, orientation: Quaternion { x: qx, y: qy, z: qz, w: qw } },
         id: id.to_owned(),
         meshes,
         operation,
         ..Default::default()
-    };
-    encode_cdr_le(&msg)
+    }
 }
 
 /// `bytes` decoded as a `moveit_msgs/CollisionObject` and applied to `pipeline`, as the node does

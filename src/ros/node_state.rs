@@ -356,18 +356,14 @@ impl NodeState {
     /// A built scene put in force (the cells re-sent), or its refusal warned about; an
     /// `apply_planning_scene` answered once the change is in force.
     pub(super) fn finish_scene(&mut self, io: &Interfaces, built: BuiltPending) {
-        let success = match self.pipeline.install_scene(built.scene) {
-            Ok(()) => {
-                self.publish_cells(io);
-                true
-            }
-            Err(skip) => {
-                self.warn_skip(&skip);
-                false
-            }
-        };
+        let installed = self.pipeline.install_scene(built.scene);
+        // In force now: the caller waits for this answer, not for the markers.
+        self.answer_apply(io, built.reply, installed.is_ok());
+        match installed {
+            Ok(()) => self.publish_cells(io),
+            Err(skip) => self.warn_skip(&skip),
+        }
         self.refresh_summary();
-        self.answer_apply(io, built.reply, success);
     }
 
     fn answer_apply(&mut self, io: &Interfaces, reply: Option<RmwRequestId>, success: bool) {

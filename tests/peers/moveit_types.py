@@ -104,6 +104,9 @@ FIELDS = [
      "string name; moveit_msgs/RobotState robot_state; string robot_model_name; geometry_msgs/TransformStamped[] fixed_frame_transforms;"
      " moveit_msgs/AllowedCollisionMatrix allowed_collision_matrix; moveit_msgs/LinkPadding[] link_padding;"
      " moveit_msgs/LinkScale[] link_scale; moveit_msgs/ObjectColor[] object_colors; moveit_msgs/PlanningSceneWorld world; bool is_diff"),
+    # moveit_msgs/srv/ApplyPlanningScene in the enhanced mapping (no request header): for the Fast DDS peer.
+    ("moveit_msgs/srv/ApplyPlanningScene_Request", "moveit_msgs/PlanningScene scene"),
+    ("moveit_msgs/srv/ApplyPlanningScene_Response", "bool success"),
     # Cyclone's request/reply mapping: a (guid, seq) header before the .srv's fields.
     ("moveit_msgs/srv/GetStateValidity_Request",
      "uint64 guid; int64 seq; moveit_msgs/RobotState robot_state; string group_name; moveit_msgs/Constraints constraints"),
@@ -157,6 +160,8 @@ Constraints = TYPES["moveit_msgs/Constraints"]
 JointConstraint = TYPES["moveit_msgs/JointConstraint"]
 Request = TYPES["moveit_msgs/GetStateValidity_Request"]
 Response = TYPES["moveit_msgs/GetStateValidity_Response"]
+ApplyRequest = TYPES["moveit_msgs/ApplyPlanningScene_Request"]
+ApplyResponse = TYPES["moveit_msgs/ApplyPlanningScene_Response"]
 
 # The same service without Cyclone's header: the enhanced mapping (Fast DDS, rmw_fastrtps_cpp),
 # for the Fast DDS peer (tests/peers/fastdds/ros_idl.py takes this form where both exist).

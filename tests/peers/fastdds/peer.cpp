@@ -34,6 +34,9 @@
 //   {"cmd":"latched","ns":"","timeout":s} -> {"cells":[...]|null,"diagnostics":[...]|null}
 //   {"cmd":"pid_stats"} -> {"rewritten":n}: related sample identities sent under another PID than
 //       0x800f (--related-sample-identity-pid 0x0083, Jazzy's; see PidRewriteTransport)
+//   {"cmd":"apply","service":"apply_planning_scene","files":[PATH...],"timeout":s}
+//       timed ApplyPlanningScene calls, each request's CDR bytes from a file (see cmd_apply)
+//       -> {"matched":bool,"answers":[{"success":bool|null,"seconds":s,"bytes":n}]}
 //   {"cmd":"quit"}
 #include "peer_json.hpp"
 #include "ros.h"
@@ -60,6 +63,8 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -807,6 +812,64 @@ std::string cmd_call(Peer& peer, const pj::Value& cmd) {
     throw std::runtime_error("unknown service type '" + type + "'");
 }
 
+// Timed apply_planning_scene calls: each request is an ApplyPlanningScene request whose CDR bytes
+// (encapsulation header first) the caller wrote to a file, decoded here into the generated type and
+// written as a typed sample, so Fast DDS serialises it as a C++ client would. One client, matched
+// first and warmed up with an empty difference (resent until answered: a reply sent before the
+// node's reply writer matched our reader is lost); then each request in turn, timed from just
+// before write() to the reply's take (polled every 0.2 ms).
+std::string cmd_apply(Peer& peer, const pj::Value& cmd) {
+    using ReqPST = moveit_msgs::srv::ApplyPlanningScene_RequestPubSubType;
+    using RespPST = moveit_msgs::srv::ApplyPlanningScene_ResponsePubSubType;
+    using Req = moveit_msgs::srv::ApplyPlanningScene_Request;
+    using Resp = moveit_msgs::srv::ApplyPlanningScene_Response;
+    std::string service = cmd["service"].str();
+    while (!service.empty() && service.front() == '/') service.erase(0, 1);
+    DataWriter* w = peer.writer<ReqPST>("rq/" + service + "Request", kServiceQos);
+    DataReader* r = peer.reader<RespPST>("rr/" + service + "Reply", kServiceQos);
+    double timeout = cmd["timeout"].num(20);
+    if (!wait_for([&] { return writer_matches(w) > 0 && reader_matches(r) > 0; }, timeout)) return pj::Obj().add("matched", "false").str();
+    // Sends `req`; waits for its reply up to `wait` seconds (resending every `resend`).
+    auto exchange = [&](Req& req, double wait, double resend) -> std::pair<int, double> {
+        std::vector<int64_t> sent;
+        double start = now_s(), end = start + wait, next = start;
+        while (now_s() < end) {
+            if (now_s() >= next) {
+                rtps::WriteParams wp;
+                wp.related_sample_identity().writer_guid(r->guid());
+                if (w->write(&req, wp)) sent.push_back(seq_i64(wp.sample_identity().sequence_number()));
+                next = resend > 0 ? now_s() + resend : end;
+            }
+            Resp resp;
+            SampleInfo info;
+            while (r->take_next_sample(&resp, &info) == ReturnCode_t::RETCODE_OK) {
+                int64_t seq = seq_i64(info.related_sample_identity.sequence_number());
+                if (info.valid_data && std::find(sent.begin(), sent.end(), seq) != sent.end()) return {resp.success() ? 1 : 0, now_s() - start};
+            }
+            sleep_s(0.0002);
+        }
+        return {-1, now_s() - start};
+    };
+    Req warm;
+    warm.scene().is_diff(true);
+    if (exchange(warm, timeout, 1.0).first != 1) return pj::Obj().add("matched", "true").add("error", pj::quote("no answer to the warm-up request")).str();
+    std::vector<std::string> answers;
+    for (const auto& f : cmd["files"].arr()) {
+        std::ifstream in(f.str(), std::ios::binary);
+        std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        if (bytes.empty()) throw std::runtime_error("cannot read " + f.str());
+        rtps::SerializedPayload_t payload(static_cast<uint32_t>(bytes.size()));
+        std::memcpy(payload.data, bytes.data(), bytes.size());
+        payload.length = static_cast<uint32_t>(bytes.size());
+        Req req;
+        ReqPST pst;
+        if (!pst.deserialize(&payload, &req)) throw std::runtime_error(f.str() + " does not decode as ApplyPlanningScene_Request");
+        auto [ok, seconds] = exchange(req, timeout, 0.0);
+        answers.push_back(pj::Obj().add("success", ok < 0 ? "null" : pj::boolean(ok == 1)).add("seconds", pj::number(seconds)).add("bytes", pj::integer(static_cast<int64_t>(bytes.size()))).str());
+    }
+    return pj::Obj().add("matched", "true").add("answers", pj::array(answers, [](const std::string& x) { return x; })).str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -846,6 +909,7 @@ int main(int argc, char** argv) {
                 else if (c == "status") out = cmd_status(peer, cmd);
                 else if (c == "latched") out = cmd_latched(peer, cmd);
                 else if (c == "call") out = cmd_call(peer, cmd);
+                else if (c == "apply") out = cmd_apply(peer, cmd);
                 else if (c == "quit") break;
                 else throw std::runtime_error("unknown command '" + c + "'");
             } catch (const std::exception& e) {
