@@ -13,6 +13,7 @@
 //! `states_on_receive.rs` answers joint states on the thread that receives them. A new input or
 //! service touches `interfaces.rs` and `node_state.rs` (and `workers.rs` when it runs off the loop).
 
+mod background;
 mod description_msg;
 mod diagnostics;
 mod discovery_range;

@@ -3,9 +3,10 @@
 //! `workers.rs`. Joint states are mostly answered before they reach the loop, on the thread that
 //! received them, whenever the loop is not holding the node's state (`states_on_receive.rs`).
 
+use super::background::Background;
 use super::interfaces::{Event, Events, Interfaces};
 use super::memory_return;
-use super::node_state::NodeState;
+use super::node_state::{NodeState, PendingScene};
 use super::param_services::{ros_mapping, ParamServers};
 use super::param_values::parameter_options;
 use super::participant::participant;
@@ -170,6 +171,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     print_banner(&pipeline, &node, &io, domain, &discovery.describe());
     let stop = Stop::install()?;
     let workers = Workers::start()?;
+    let background = Background::start().context("cannot start the background thread")?;
     let spinner = node.spinner().map_err(|e| anyhow!("spinner: {e:?}"))?;
     let state = NodeState::new(pipeline, node.fully_qualified_name(), stop.summary.clone());
     let checking = Arc::new(Mutex::new(Checking::new(state, io.clone())));
@@ -179,6 +181,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         io: &io,
         param_servers: param_servers.as_ref(),
         workers: &workers,
+        background: &background,
         checking: &checking,
         on_receive: &on_receive,
         changes: &changes,
@@ -205,6 +208,7 @@ struct Running<'a> {
     io: &'a Arc<Interfaces>,
     param_servers: Option<&'a ParamServers>,
     workers: &'a Workers,
+    background: &'a Background,
     checking: &'a Arc<Mutex<Checking>>,
     on_receive: &'a Arc<OnReceive>,
     changes: &'a smol::channel::Receiver<Params>,
@@ -214,6 +218,32 @@ impl Running<'_> {
     /// The node's state, held. Poisoned only by a panic in a check, which ends the process anyway.
     fn hold(&self) -> std::sync::MutexGuard<'_, Checking> {
         self.checking.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// Answers the joint states waiting and leaves the receiving thread's waker with the reader,
+    /// before the loop lets go of the state for a while.
+    fn rearm(&self, held: &mut Checking) {
+        if self.io.tf.is_none() {
+            self.on_receive.answer_waiting(held, self.io, false);
+        }
+    }
+
+    /// A scene change built and its cells drawn on the background thread, installed in between.
+    async fn build_scene(&self, pending: PendingScene) {
+        let built = self.background.run(move || pending.build()).await;
+        let cells = {
+            let mut held = self.hold();
+            let cells = held.state.finish_scene(self.io, built);
+            self.rearm(&mut held);
+            cells
+        };
+        if let Some(cells) = cells {
+            // Drawn and serialised there too (milliseconds for a large scene).
+            let shared = Arc::clone(self.io);
+            if !self.background.run(move || cells.publish(&shared)).await {
+                self.hold().state.on_cells_failed(self.io);
+            }
+        }
     }
 
     /// Every input as one stream of events. `select_all` polls only the sources that woke it (a
@@ -267,21 +297,28 @@ impl Running<'_> {
                     }
                     continue;
                 }
-                let mut held = self.hold();
-                // A parameter change accepted before this input arrived applies to it.
-                held.state.apply_params(io, self.changes);
                 // A planning-scene input: its cells are built with the state free, so the states
                 // that arrive meanwhile are answered (on the receiving thread) against the scene
                 // in force; nothing else changes the checker before it is installed.
                 if event.is_scene() {
-                    let pending = held.state.take_scene_event(io, event);
-                    drop(held);
+                    let pending = {
+                        let mut held = self.hold();
+                        held.state.apply_params(io, self.changes);
+                        let pending = held.state.take_scene_event(io, event);
+                        // A state that came while the lock was held passed its turn to this loop
+                        // and left no waker with the reader: re-armed here, the states that come
+                        // during the build and the drawing are answered on the receiving thread.
+                        self.rearm(&mut held);
+                        pending
+                    };
                     if let Some(pending) = pending {
-                        let built = pending.build();
-                        self.hold().state.finish_scene(io, built);
+                        self.build_scene(pending).await;
                     }
                     continue;
                 }
+                let mut held = self.hold();
+                // A parameter change accepted before this input arrived applies to it.
+                held.state.apply_params(io, self.changes);
                 match event {
                     Event::States => on_receive.answer_waiting(&mut held, io, false),
                     Event::Tick => tick_due = true,

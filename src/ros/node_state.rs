@@ -9,6 +9,7 @@ use super::interfaces::{Event, Interfaces};
 use super::memory_return::MemoryReturn;
 use super::rate_limited_log::RateLimitedLog;
 use super::workers::Workers;
+use crate::checker::Checker;
 use crate::limits::MAX_DESCRIPTION_BYTES;
 use crate::markers::{cell_markers, contact_markers};
 use crate::model::Params;
@@ -48,6 +49,22 @@ pub(super) struct PendingScene {
     plan: ScenePlan,
     /// The `apply_planning_scene` request to answer once it is in force.
     reply: Option<RmwRequestId>,
+}
+
+/// The cell markers of a checker, drawn and sent without the node's state held: for a scene of
+/// many objects that takes milliseconds, and states are answered meanwhile.
+pub(super) struct CellsToDraw {
+    checker: Arc<Checker>,
+    max: usize,
+    world: String,
+    now: Time,
+}
+
+impl CellsToDraw {
+    /// Draws and sends them; false when the writer refused.
+    pub(super) fn publish(self, io: &Interfaces) -> bool {
+        io.cells.publish(cell_markers(&self.checker, self.max, &self.world, self.now)).is_ok()
+    }
 }
 
 /// A [`PendingScene`] built (by whoever does not hold the node's state).
@@ -110,8 +127,9 @@ impl NodeState {
             Event::ValidityDone(id, answer, reason) => self.send_validity_answer(io, id, answer, reason),
             // Prepared here, built without the state held, installed here (`node_run.rs`).
             Event::CollisionObject(_) | Event::AttachedObject(_) | Event::Scene(_) | Event::SceneWorld(_) | Event::ApplyScene(..) => {
-                if let Some(pending) = self.take_scene_event(io, event) {
-                    self.finish_scene(io, pending.build());
+                let cells = self.take_scene_event(io, event).and_then(|pending| self.finish_scene(io, pending.build()));
+                if cells.is_some_and(|c| !c.publish(io)) {
+                    self.on_cells_failed(io);
                 }
             }
             Event::GetScene(id, req) => self.on_get_scene(io, id, req),
@@ -172,10 +190,20 @@ impl NodeState {
     }
 
     pub(super) fn publish_cells(&mut self, io: &Interfaces) {
-        let (max, world, now) = (self.pipeline.params().marker_max_cells.max(0) as usize, self.world(), self.now());
-        if io.cells.publish(cell_markers(self.pipeline.checker(), max, &world, now)).is_err() {
-            self.log.warn("markers", || format!("publishing {} failed", io.names.cells));
+        if !self.cells_to_draw().publish(io) {
+            self.on_cells_failed(io);
         }
+    }
+
+    /// What the cell markers of the checker in force need, to be drawn and sent with the state
+    /// free.
+    pub(super) fn cells_to_draw(&self) -> CellsToDraw {
+        let max = self.pipeline.params().marker_max_cells.max(0) as usize;
+        CellsToDraw { checker: Arc::clone(self.pipeline.checker()), max, world: self.world(), now: self.now() }
+    }
+
+    pub(super) fn on_cells_failed(&mut self, io: &Interfaces) {
+        self.log.warn("markers", || format!("publishing {} failed", io.names.cells));
     }
 
     /// Parameter changes accepted by the service, applied before the next input is handled. Each
@@ -353,17 +381,20 @@ impl NodeState {
         }
     }
 
-    /// A built scene put in force (the cells re-sent), or its refusal warned about; an
-    /// `apply_planning_scene` answered once the change is in force.
-    pub(super) fn finish_scene(&mut self, io: &Interfaces, built: BuiltPending) {
+    /// A built scene put in force, or its refusal warned about; an `apply_planning_scene`
+    /// answered once the change is in force. The caller draws the cells it returns.
+    pub(super) fn finish_scene(&mut self, io: &Interfaces, built: BuiltPending) -> Option<CellsToDraw> {
         let installed = self.pipeline.install_scene(built.scene);
         // In force now: the caller waits for this answer, not for the markers.
         self.answer_apply(io, built.reply, installed.is_ok());
-        match installed {
-            Ok(()) => self.publish_cells(io),
-            Err(skip) => self.warn_skip(&skip),
-        }
         self.refresh_summary();
+        match installed {
+            Ok(()) => Some(self.cells_to_draw()),
+            Err(skip) => {
+                self.warn_skip(&skip);
+                None
+            }
+        }
     }
 
     fn answer_apply(&mut self, io: &Interfaces, reply: Option<RmwRequestId>, success: bool) {

@@ -36,7 +36,9 @@
 //       0x800f (--related-sample-identity-pid 0x0083, Jazzy's; see PidRewriteTransport)
 //   {"cmd":"apply","service":"apply_planning_scene","files":[PATH...],"timeout":s}
 //       timed ApplyPlanningScene calls, each request's CDR bytes from a file (see cmd_apply)
-//       -> {"matched":bool,"answers":[{"success":bool|null,"seconds":s,"bytes":n}]}
+//       -> {"matched":bool,"answers":[{"success":bool|null,"seconds":s}]}
+//   {"cmd":"publish","topic":"collision_object","files":[PATH...],"rate":hz,"seconds":s,"timeout":s}
+//       CollisionObjects (CDR files) written in turn at `rate` -> {"matched":bool,"sent":n,"late":n}
 //   {"cmd":"quit"}
 #include "peer_json.hpp"
 #include "ros.h"
@@ -812,9 +814,45 @@ std::string cmd_call(Peer& peer, const pj::Value& cmd) {
     throw std::runtime_error("unknown service type '" + type + "'");
 }
 
+// The CDR bytes in `path` (encapsulation header first) decoded into the generated type of PST.
+template <class PST, class Msg>
+Msg decode_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (bytes.empty()) throw std::runtime_error("cannot read " + path);
+    rtps::SerializedPayload_t payload(static_cast<uint32_t>(bytes.size()));
+    std::memcpy(payload.data, bytes.data(), bytes.size());
+    payload.length = static_cast<uint32_t>(bytes.size());
+    Msg msg;
+    PST pst;
+    if (!pst.deserialize(&payload, &msg)) throw std::runtime_error(path + " does not decode as " + pst.getName());
+    return msg;
+}
+
+// Scene traffic: the CollisionObjects of `files` (decoded once, before the clock starts) written
+// in turn on rt/<topic> at `rate` Hz for `seconds`, as an application publishes them (reliable,
+// volatile, keep last 10: MoveIt's ServicesQoS, what the node's reader asks for).
+std::string cmd_publish(Peer& peer, const pj::Value& cmd) {
+    using PST = moveit_msgs::msg::CollisionObjectPubSubType;
+    using Msg = moveit_msgs::msg::CollisionObject;
+    std::vector<Msg> msgs;
+    for (const auto& f : cmd["files"].arr()) msgs.push_back(decode_file<PST, Msg>(f.str()));
+    if (msgs.empty()) throw std::runtime_error("publish: no files");
+    DataWriter* w = peer.writer<PST>("rt/" + cmd["topic"].str(), kServiceQos);
+    if (!wait_for([&] { return writer_matches(w) > 0; }, cmd["timeout"].num(20))) return pj::Obj().add("matched", "false").str();
+    double period = 1.0 / cmd["rate"].num(20), start = now_s(), end = start + cmd["seconds"].num(5);
+    int64_t sent = 0, late = 0;
+    for (double next = start; now_s() < end; next += period) {
+        double wait = next - now_s();
+        if (wait > 0) sleep_s(wait);
+        else if (wait < -period / 2) ++late;
+        if (w->write(&msgs[static_cast<size_t>(sent) % msgs.size()])) ++sent;
+    }
+    return pj::Obj().add("matched", "true").add("sent", pj::integer(sent)).add("late", pj::integer(late)).str();
+}
+
 // Timed apply_planning_scene calls: each request is an ApplyPlanningScene request whose CDR bytes
-// (encapsulation header first) the caller wrote to a file, decoded here into the generated type and
-// written as a typed sample, so Fast DDS serialises it as a C++ client would. One client, matched
+// the caller wrote to a file, decoded here into the generated type and written as a typed sample, so Fast DDS serialises it as a C++ client would. One client, matched
 // first and warmed up with an empty difference (resent until answered: a reply sent before the
 // node's reply writer matched our reader is lost); then each request in turn, timed from just
 // before write() to the reply's take (polled every 0.2 ms).
@@ -855,17 +893,9 @@ std::string cmd_apply(Peer& peer, const pj::Value& cmd) {
     if (exchange(warm, timeout, 1.0).first != 1) return pj::Obj().add("matched", "true").add("error", pj::quote("no answer to the warm-up request")).str();
     std::vector<std::string> answers;
     for (const auto& f : cmd["files"].arr()) {
-        std::ifstream in(f.str(), std::ios::binary);
-        std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        if (bytes.empty()) throw std::runtime_error("cannot read " + f.str());
-        rtps::SerializedPayload_t payload(static_cast<uint32_t>(bytes.size()));
-        std::memcpy(payload.data, bytes.data(), bytes.size());
-        payload.length = static_cast<uint32_t>(bytes.size());
-        Req req;
-        ReqPST pst;
-        if (!pst.deserialize(&payload, &req)) throw std::runtime_error(f.str() + " does not decode as ApplyPlanningScene_Request");
+        Req req = decode_file<ReqPST, Req>(f.str());
         auto [ok, seconds] = exchange(req, timeout, 0.0);
-        answers.push_back(pj::Obj().add("success", ok < 0 ? "null" : pj::boolean(ok == 1)).add("seconds", pj::number(seconds)).add("bytes", pj::integer(static_cast<int64_t>(bytes.size()))).str());
+        answers.push_back(pj::Obj().add("success", ok < 0 ? "null" : pj::boolean(ok == 1)).add("seconds", pj::number(seconds)).str());
     }
     return pj::Obj().add("matched", "true").add("answers", pj::array(answers, [](const std::string& x) { return x; })).str();
 }
@@ -910,6 +940,7 @@ int main(int argc, char** argv) {
                 else if (c == "latched") out = cmd_latched(peer, cmd);
                 else if (c == "call") out = cmd_call(peer, cmd);
                 else if (c == "apply") out = cmd_apply(peer, cmd);
+                else if (c == "publish") out = cmd_publish(peer, cmd);
                 else if (c == "quit") break;
                 else throw std::runtime_error("unknown command '" + c + "'");
             } catch (const std::exception& e) {
