@@ -210,6 +210,30 @@ fn robot_description_from_the_bag() {
     same_lines(&std::fs::read_to_string(&jsonl).unwrap().lines().map(str::to_owned).collect::<Vec<_>>(), &reference, "description");
 }
 
+/// A bag's robot description is applied from the topic `robot_description_topic` names, and not at
+/// all when it is empty, as the node's door (the fat arm in the bag: the open door follows it, the
+/// closed one keeps the bundled arm).
+#[test]
+fn a_closed_description_door_keeps_the_robot_in_replay() {
+    let st = states(60, 9);
+    let d = dir("desc_closed");
+    let bag = d.join("bag");
+    write_bag(&bag, "mcap", &joint_messages(&st), Some(common::fat_arm_urdf()));
+    let thin = check_reference(&d, &state_lines(&st));
+    let fat_file = d.join("fat.urdf");
+    std::fs::write(&fat_file, common::fat_arm_urdf()).unwrap();
+    let fat = check_reference_with(&d, &state_lines(&st), &["--robot", fat_file.to_str().unwrap()]);
+    assert_ne!(thin, fat, "the two robots must answer differently");
+    let jsonl = d.join("open.jsonl");
+    let _ = ok(replay(&bag, &["--jsonl", jsonl.to_str().unwrap()]));
+    same_lines(&std::fs::read_to_string(&jsonl).unwrap().lines().map(str::to_owned).collect::<Vec<_>>(), &fat, "open door");
+    let params = d.join("closed.yaml");
+    std::fs::write(&params, "thickness_collision:\n  ros__parameters:\n    robot_description_topic: \"\"\n").unwrap();
+    let jsonl = d.join("closed.jsonl");
+    let _ = ok(replay(&bag, &["--params-file", params.to_str().unwrap(), "--jsonl", jsonl.to_str().unwrap()]));
+    same_lines(&std::fs::read_to_string(&jsonl).unwrap().lines().map(str::to_owned).collect::<Vec<_>>(), &thin, "closed door");
+}
+
 #[test]
 fn corrupt_tail_and_undecodable_message_keep_the_reports_before() {
     let st = states(3000, 5);

@@ -6,6 +6,7 @@ mod collada_guard;
 #[cfg(feature = "testing")]
 pub mod example_workcell;
 // Crate-visible for `fuzz_access`, which hands the fuzz harness the parser behind `read_mesh`.
+mod glob;
 pub(crate) mod mesh_file;
 mod package;
 mod params;
@@ -17,6 +18,7 @@ mod xacro;
 mod xml_guard;
 
 pub use self::bundled::bundled_config_dir;
+pub(crate) use self::glob::glob_match;
 pub(crate) use self::mesh_file::scale_mesh;
 #[cfg(feature = "testing")]
 pub use self::mesh_file::write_obj;

@@ -8,6 +8,7 @@
 //! Reading the files (which sections apply to the node) is in `params_file`.
 
 use super::bundled::{bundled_environment, bundled_robot};
+use super::glob::glob_match;
 use crate::thickness::Side;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -158,6 +159,15 @@ pub struct Params {
     /// The node serves MoveIt's planning-scene doors (`collision_object`, `planning_scene`, ...,
     /// `apply_planning_scene`, `get_planning_scene`); read at start.
     pub planning_scene: bool,
+    /// The topic the robot's URDF comes on (`std_msgs/String`, latched), relative to the node;
+    /// empty: not subscribed (a deployment that loads its robot from a file closes this door);
+    /// read at start.
+    pub robot_description_topic: String,
+    /// The topic the robot's SRDF comes on; empty: not subscribed; read at start.
+    pub robot_description_semantic_topic: String,
+    /// Parameters (names or globs, `*` for all) a remote `set_parameters` may not change, on top
+    /// of those that shape the node's topics; itself always read only; read at start.
+    pub read_only_parameters: Vec<String>,
     /// Files named on the command line in place of the two above.
     #[serde(skip)]
     pub input_files: InputFiles,
@@ -204,6 +214,9 @@ impl Default for Params {
             robot_semantic_file: String::new(),
             self_collision: true,
             planning_scene: true,
+            robot_description_topic: "robot_description".into(),
+            robot_description_semantic_topic: "robot_description_semantic".into(),
+            read_only_parameters: Vec::new(),
             input_files: InputFiles::default(),
         }
     }
@@ -321,6 +334,13 @@ impl Params {
         if !(self.marker_rate >= lo && self.marker_rate <= hi) {
             return bad("marker_rate", format!("must be a rate from {lo} to {hi} Hz, got {:?}", self.marker_rate));
         }
+        for (name, topic) in
+            [("robot_description_topic", &self.robot_description_topic), ("robot_description_semantic_topic", &self.robot_description_semantic_topic)]
+        {
+            if topic.chars().any(|c| !(c.is_ascii_alphanumeric() || matches!(c, '_' | '/' | '~'))) {
+                return bad(name, format!("must be a ROS topic name (letters, digits, '_', '/', '~') or empty (not subscribed), got '{topic}'"));
+            }
+        }
         if self.world_frame.trim_start_matches('/').is_empty() {
             return bad("world_frame", format!("must name a frame, got '{}'", self.world_frame));
         }
@@ -398,6 +418,7 @@ impl Params {
             padding: Padding { links: vec![String::new()], values: vec![0.0] },
             allowed_collisions: vec![String::new()],
             checked_links: vec![String::new()],
+            read_only_parameters: vec![String::new()],
             ..Params::default()
         };
         sample
@@ -469,44 +490,11 @@ pub(super) fn show_keys(keys: &[String]) -> String {
     keys.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ")
 }
 
-/// Glob match with `*` (any run) and `?` (one character).
-pub(crate) fn glob_match(pattern: &str, text: &str) -> bool {
-    let (p, t): (Vec<char>, Vec<char>) = (pattern.chars().collect(), text.chars().collect());
-    let (mut pi, mut ti, mut star, mut mark) = (0, 0, None, 0);
-    while ti < t.len() {
-        if pi < p.len() && (p[pi] == '?' || p[pi] == t[ti]) {
-            pi += 1;
-            ti += 1;
-        } else if pi < p.len() && p[pi] == '*' {
-            star = Some(pi);
-            mark = ti;
-            pi += 1;
-        } else if let Some(s) = star {
-            pi = s + 1;
-            mark += 1;
-            ti = mark;
-        } else {
-            return false;
-        }
-    }
-    p[pi..].iter().all(|&c| c == '*')
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::params_file::*;
     use super::*;
     use std::path::Path;
-
-    #[test]
-    fn globs() {
-        assert!(glob_match("*", "anything"));
-        assert!(glob_match("guard_*", "guard_sheet"));
-        assert!(!glob_match("guard_*", "shelf"));
-        assert!(glob_match("link?", "link7"));
-        assert!(glob_match("*_sheet", "guard_sheet"));
-        assert!(!glob_match("link?", "link10"));
-    }
 
     #[test]
     fn unknown_key_is_named() {
@@ -527,6 +515,8 @@ mod tests {
         assert_eq!(q.default_thickness, 0.05);
         assert_eq!(q.thin_surfaces.thickness, vec![1.0]);
         assert_eq!(q.surface_settings("a"), (1.0, Side::Back));
+        let q = p.with_overrides(&[("robot_description_topic".into(), "''".into()), ("read_only_parameters".into(), "['*']".into())]).unwrap();
+        assert_eq!((q.robot_description_topic.as_str(), q.read_only_parameters.as_slice()), ("", &["*".to_string()][..]), "an empty topic closes the door");
         let q = p.with_overrides(&[("pose_source".into(), "tf".into()), ("missing_joint".into(), "reject".into())]).unwrap();
         assert_eq!((q.pose_source, q.missing_joint), (PoseSource::Tf, MissingJoint::Reject));
         for (k, v, says) in [
@@ -536,6 +526,8 @@ mod tests {
             ("nonexistent", "1", "nonexistent"),
             ("thin_surfaces", "1", "group"),
             ("default_thickness", "-1", "default_thickness"),
+            ("robot_description_topic", "'a b'", "robot_description_topic"),
+            ("robot_description_semantic_topic", "'srdf!'", "robot_description_semantic_topic"),
         ] {
             let e = p.with_overrides(&[(k.into(), v.into())]).unwrap_err().to_string();
             assert!(e.contains(says), "{k}:={v}: {e}");

@@ -202,6 +202,9 @@ struct Replayer<'a> {
     topic: String,
     expected: &'static str,
     pose_source: PoseSource,
+    /// The topics robot descriptions and SRDFs are applied from (`robot_description_topic` and
+    /// `robot_description_semantic_topic`, absolute); `None`: closed, as in the node.
+    doors: [Option<String>; 2],
     t0: Option<i64>,
     read: u64,
     started: Instant,
@@ -226,9 +229,11 @@ impl<'a> Replayer<'a> {
             PoseSource::Tf => "/tf".into(),
         });
         let expected = input_type(&bag, &topic, pose_source, &opts.bag)?;
+        let door = |name: &str| (!name.is_empty()).then(|| format!("/{}", name.trim_start_matches('/')));
+        let doors = [door(&params.robot_description_topic), door(&params.robot_description_semantic_topic)];
         // Both doors start with the robot the parameters name; a description in the bag replaces
         // it at its log time, as it would replace it in the running node.
-        let pipeline = if bag.topics().iter().any(|(t, _)| t == DESCRIPTION_TOPIC) {
+        let pipeline = if bag.topics().iter().any(|(t, _)| Some(t) == doors[0].as_ref()) {
             // An SRDF given for the recorded robot is checked against it when it comes.
             Pipeline::new_expecting_description(params)?
         } else {
@@ -245,6 +250,7 @@ impl<'a> Replayer<'a> {
             topic,
             expected,
             pose_source,
+            doors,
             t0: None,
             read: 0,
             started: Instant::now(),
@@ -288,11 +294,11 @@ impl<'a> Replayer<'a> {
     /// why it is none.
     fn state_of(&mut self, m: &BagMessage, seconds: f64) -> Option<Result<Option<RobotState>, Skip>> {
         let (opts, pipeline, warnings) = (self.opts, &mut self.pipeline, &mut self.warnings);
-        if m.topic == DESCRIPTION_TOPIC {
+        if Some(&m.topic) == self.doors[0].as_ref() {
             apply_description(pipeline, m, &opts.bag, &mut self.summary, warnings);
             return None;
         }
-        if m.topic == SEMANTIC_TOPIC {
+        if Some(&m.topic) == self.doors[1].as_ref() {
             apply_semantic(pipeline, m, &opts.bag, &mut self.summary, warnings);
             return None;
         }

@@ -76,8 +76,9 @@ pub(super) type Events<'a> = Pin<Box<dyn Stream<Item = Event> + 'a>>;
 pub(super) struct Interfaces {
     pub(super) states: Subscription<JointState>,
     pub(super) tf: Option<(Subscription<TfMessage>, Subscription<TfMessage>)>,
-    descriptions: Subscription<DescriptionMsg>,
-    semantics: Subscription<DescriptionMsg>,
+    /// With `robot_description_topic` (and `robot_description_semantic_topic`) not empty.
+    descriptions: Option<Subscription<DescriptionMsg>>,
+    semantics: Option<Subscription<DescriptionMsg>>,
     clock: Option<Subscription<ClockMsg>>,
     pub(super) collisions: Publisher<CollisionReport>,
     pub(super) cells: Publisher<MarkerArray>,
@@ -155,15 +156,17 @@ pub(super) struct Names {
 }
 
 impl Names {
-    fn new(remaps: &[(String, String)]) -> Names {
+    /// The names, remapped; an empty topic parameter gives an empty name (not subscribed).
+    fn new(remaps: &[(String, String)], params: &Params) -> Names {
+        let optional = |topic: &str| if topic.is_empty() { String::new() } else { resolve(remaps, topic) };
         Names {
             joint_states: resolve(remaps, "joint_states"),
             collisions: resolve(remaps, "collisions"),
             check_states: resolve(remaps, "check_states"),
             check_trajectory: resolve(remaps, "check_trajectory"),
             check_state_validity: resolve(remaps, "check_state_validity"),
-            description: resolve(remaps, "robot_description"),
-            semantic: resolve(remaps, "robot_description_semantic"),
+            description: optional(&params.robot_description_topic),
+            semantic: optional(&params.robot_description_semantic_topic),
             cells: resolve(remaps, "collision_markers/cells"),
             contacts: resolve(remaps, "collision_markers/contacts"),
             collision_object: resolve(remaps, "collision_object"),
@@ -252,15 +255,21 @@ impl Interfaces {
     pub(super) fn build(node: &mut Node, params: &Params, ros_args: &RosArgs) -> Result<Interfaces> {
         let ns = ros_args.namespace.clone().unwrap_or_else(|| "/".into());
         let (ns, remaps) = (ns.as_str(), &ros_args.remaps);
-        let names = Names::new(remaps);
+        let names = Names::new(remaps, params);
         let js = topic(node, &names.joint_states, ns, ("sensor_msgs", "JointState"), &best_effort(STATES_KEPT))?;
         let states = subscription(node, &js, Some(best_effort(STATES_KEPT)), &names.joint_states)?;
         let desc_qos = latched(QosProfile::subscription_default(), 1);
-        let desc = topic(node, &names.description, ns, ("std_msgs", "String"), &desc_qos)?;
-        let descriptions = subscription(node, &desc, Some(desc_qos.clone()), &names.description)?;
-        // The SRDF, latched as move_group offers it; bounded like the description.
-        let sem = topic(node, &names.semantic, ns, ("std_msgs", "String"), &desc_qos)?;
-        let semantics = subscription(node, &sem, Some(desc_qos.clone()), &names.semantic)?;
+        // The URDF and the SRDF, latched as robot_state_publisher and move_group offer them;
+        // doors a deployment may close (an empty topic parameter).
+        let mut text_door = |name: &str| -> Result<Option<Subscription<DescriptionMsg>>> {
+            if name.is_empty() {
+                return Ok(None);
+            }
+            let t = topic(node, name, ns, ("std_msgs", "String"), &desc_qos)?;
+            Ok(Some(subscription(node, &t, Some(desc_qos.clone()), name)?))
+        };
+        let descriptions = text_door(&names.description)?;
+        let semantics = text_door(&names.semantic)?;
         let clock = if params.use_sim_time {
             let t = topic(node, "/clock", "/", ("rosgraph_msgs", "Clock"), &best_effort(1))?;
             Some(subscription(node, &t, None, "/clock")?)
@@ -312,8 +321,12 @@ impl Interfaces {
             sources.push(read(tf, "/tf", Event::Tf));
             sources.push(read(tf_static, "/tf_static", Event::TfStatic));
         }
-        sources.push(read(&self.descriptions, "robot_description", Event::Description));
-        sources.push(read(&self.semantics, "robot_description_semantic", Event::Semantic));
+        if let Some(d) = &self.descriptions {
+            sources.push(read(d, "robot_description", Event::Description));
+        }
+        if let Some(s) = &self.semantics {
+            sources.push(read(s, "robot_description_semantic", Event::Semantic));
+        }
         if let Some(clock) = &self.clock {
             sources.push(read(clock, "/clock", |m: ClockMsg| Event::Clock(m.clock)));
         }

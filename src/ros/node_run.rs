@@ -8,7 +8,7 @@ use super::interfaces::{Event, Events, Interfaces};
 use super::memory_return;
 use super::node_state::{NodeState, PendingScene};
 use super::param_services::{ros_mapping, ParamServers};
-use super::param_values::parameter_options;
+use super::param_values::{parameter_options, ReadOnly};
 use super::participant::participant;
 use super::ros_args::RosArgs;
 use super::states_on_receive::{Checking, OnReceive};
@@ -131,6 +131,15 @@ fn print_banner(pipeline: &Pipeline, node: &Node, io: &Interfaces, domain: u16, 
     );
     println!("  {}", pipeline.checker().self_pairs().summary(pipeline.checker()));
     // Before the line that ends the banner (the one that says what it serves).
+    let door = |name: &str, parameter: &str| if name.is_empty() { format!("closed ({parameter} empty)") } else { name.to_owned() };
+    println!(
+        "  robot description: {}; SRDF: {}",
+        door(&io.names.description, "robot_description_topic"),
+        door(&io.names.semantic, "robot_description_semantic_topic")
+    );
+    if !p.read_only_parameters.is_empty() {
+        println!("  read-only parameters: {}", p.read_only_parameters.join(", "));
+    }
     if io.scene.is_some() {
         let n = &io.names;
         println!(
@@ -167,7 +176,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         )
         .map_err(|e| anyhow!("cannot create the node: {e:?}"))?;
     let io = Arc::new(Interfaces::build(&mut node, pipeline.params(), &opts.ros_args)?);
-    let param_servers = ParamServers::build(&mut node, ros_mapping(pipeline.params().service_mapping))?;
+    let param_servers = ParamServers::build(&mut node, ros_mapping(pipeline.params().service_mapping), ReadOnly::of(pipeline.params()))?;
     print_banner(&pipeline, &node, &io, domain, &discovery.describe());
     let stop = Stop::install()?;
     let workers = Workers::start()?;

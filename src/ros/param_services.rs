@@ -1,19 +1,18 @@
 //! The node's parameter services (`rcl_interfaces`: get, get types, set, set atomically, list,
-//! describe) with the node's `service_mapping`, for the mappings ros2-client does not serve them
-//! with.
+//! describe) with the node's `service_mapping`, served by the node in every mapping.
 //!
 //! ros2-client 0.12 starts these services itself only with the enhanced mapping (its `node.rs`:
 //! `let service_mapping = ServiceMapping::Enhanced; //TODO: parameterize`), where the request id
 //! travels as the sample identity. `ros2 param` on `rmw_cyclonedds_cpp` puts it in the payload
-//! (the Cyclone mapping) and could not reach them. So with `basic` or `cyclone` the node turns
-//! ros2-client's services off and serves the same six here, from the node's own parameter store:
+//! (the Cyclone mapping) and could not reach them; and ros2-client describes every parameter as
+//! writable. So the node turns ros2-client's services off and serves the same six here, from the node's own parameter store:
 //! `Node::get_parameter`, and `Node::set_parameter`, which runs the same rules (declared name,
 //! type kept), the node's set action (validation, the change handed to the loop) and publishes
 //! `/parameter_events`. The answers are those ros2-client gives (its `Spinner::spin`), except
-//! that the parameters the node fixes at start are described `read_only` (ros2-client describes
-//! every parameter as writable).
+//! that the parameters the node fixes at start and those `read_only_parameters` names are
+//! described `read_only`.
 
-use super::param_values::READ_ONLY;
+use super::param_values::ReadOnly;
 use anyhow::{anyhow, Result};
 use futures::stream::{FusedStream, StreamExt};
 use ros2_client::parameters::{raw, ParameterDescriptor, ParameterValue};
@@ -50,15 +49,11 @@ pub(crate) struct ParamServers {
     set_atomically: Server<SetParametersRequest, SetParametersAtomicallyResponse>,
     list: Server<ListParametersRequest, ListParametersResponse>,
     describe: Server<DescribeParametersRequest, DescribeParametersResponse>,
+    read_only: ReadOnly,
 }
 
 /// Every request of the six services, in arrival order per service.
 pub(crate) type ParamRequests<'a> = Pin<Box<dyn FusedStream<Item = ReadResult<ParamRequest>> + 'a>>;
-
-/// Whether ros2-client serves the parameter services itself (only with the enhanced mapping).
-pub(crate) fn served_by_ros2_client(mapping: ServiceMapping) -> bool {
-    mapping == ServiceMapping::Enhanced
-}
 
 /// The node's `service_mapping` parameter as ros2-client's mapping.
 pub(crate) fn ros_mapping(mapping: crate::model::ServiceMapping) -> ServiceMapping {
@@ -70,12 +65,9 @@ pub(crate) fn ros_mapping(mapping: crate::model::ServiceMapping) -> ServiceMappi
 }
 
 impl ParamServers {
-    /// The servers under the node's name (`<node>/get_parameters`, ...) with `mapping`; `None`
-    /// when ros2-client serves them (the enhanced mapping).
-    pub(crate) fn build(node: &mut Node, mapping: ServiceMapping) -> Result<Option<ParamServers>> {
-        if served_by_ros2_client(mapping) {
-            return Ok(None);
-        }
+    /// The servers under the node's name (`<node>/get_parameters`, ...) with `mapping`, describing
+    /// `read_only`'s parameters as read only.
+    pub(crate) fn build(node: &mut Node, mapping: ServiceMapping, read_only: ReadOnly) -> Result<Option<ParamServers>> {
         // rmw_qos_profile_services_default: reliable, volatile, keep last 10.
         let qos = QosProfile::publisher_default().reliability_reliable(WhenFull::DEFAULT).history(History::KeepLast { depth: 10 });
         let fqn = node.fully_qualified_name();
@@ -95,6 +87,7 @@ impl ParamServers {
             describe: node
                 .create_server(mapping, &name("describe_parameters")?, &ty("DescribeParameters"), qos.clone(), qos)
                 .map_err(err("describe_parameters"))?,
+            read_only,
         }))
     }
 
@@ -136,7 +129,7 @@ impl ParamServers {
                 self.list.async_send_response(id, ListParametersResponse { result }).await.map_err(|_| "list_parameters")
             }
             ParamRequest::Describe(id, q) => {
-                let values = q.names.iter().map(|n| describe(n, node.get_parameter(n))).collect();
+                let values = q.names.iter().map(|n| describe(n, node.get_parameter(n), &self.read_only)).collect();
                 self.describe.async_send_response(id, DescribeParametersResponse { values }).await.map_err(|_| "describe_parameters")
             }
         }
@@ -187,13 +180,13 @@ fn list(names: &[String], prefixes: &[String], depth: u64) -> ListParametersResu
     result
 }
 
-fn describe(name: &str, value: Option<ParameterValue>) -> raw::ParameterDescriptor {
+fn describe(name: &str, value: Option<ParameterValue>, read_only: &ReadOnly) -> raw::ParameterDescriptor {
     let mut d = match &value {
         Some(v) => ParameterDescriptor::from_value(name, v),
         None => ParameterDescriptor::unknown(name),
     };
     if value.is_some() {
-        d.read_only = READ_ONLY.contains(&name);
+        d.read_only = read_only.reason(name).is_some();
         d.description = String::new();
     }
     raw::ParameterDescriptor::from(d)
@@ -226,11 +219,16 @@ mod tests {
 
     #[test]
     fn describe_marks_the_fixed_parameters_read_only() {
-        let d = describe("service_mapping", Some(ParameterValue::String("cyclone".into())));
+        let params = crate::model::Params { read_only_parameters: vec!["thin_surfaces.*".into()], ..Default::default() };
+        let ro = ReadOnly::of(&params);
+        let d = describe("service_mapping", Some(ParameterValue::String("cyclone".into())), &ro);
         assert!(d.read_only && d.r#type == raw::ParameterType::STRING);
-        let d = describe("default_thickness", Some(ParameterValue::Double(0.02)));
+        let d = describe("default_thickness", Some(ParameterValue::Double(0.02)), &ro);
         assert!(!d.read_only && d.r#type == raw::ParameterType::DOUBLE);
-        let d = describe("no_such", None);
+        let d = describe("thin_surfaces.thickness", Some(ParameterValue::DoubleArray(vec![])), &ro);
+        assert!(d.read_only);
+        assert!(describe("read_only_parameters", Some(ParameterValue::StringArray(vec![])), &ro).read_only);
+        let d = describe("no_such", None, &ro);
         assert_eq!(d.r#type, raw::ParameterType::NOT_SET);
     }
 }

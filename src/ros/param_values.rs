@@ -1,13 +1,37 @@
 //! The node's parameters as ROS 2 parameter values: declared from [`Params::flat`], and a value
 //! set through the parameter services turned back into typed parameters.
 
-use crate::model::{Params, ServiceMapping};
+use crate::model::{glob_match, Params};
 use ros2_client::{NodeOptions, ParameterValue};
 use serde_json::Value;
 use std::sync::{Arc, Mutex};
 
-/// Parameters that shape the node's topics and services, fixed once they are created.
-pub(crate) const READ_ONLY: [&str; 4] = ["planning_scene", "pose_source", "service_mapping", "use_sim_time"];
+/// Parameters that shape the node's topics and services, fixed once they are created, and the
+/// list that fixes others.
+const FIXED: [&str; 7] =
+    ["planning_scene", "pose_source", "service_mapping", "use_sim_time", "robot_description_topic", "robot_description_semantic_topic", "read_only_parameters"];
+
+/// Which parameters a remote `set_parameters` may not change: [`FIXED`], and those the
+/// deployment's `read_only_parameters` names (read at start).
+#[derive(Clone, Debug)]
+pub(crate) struct ReadOnly {
+    patterns: Vec<String>,
+}
+
+impl ReadOnly {
+    pub(crate) fn of(params: &Params) -> ReadOnly {
+        ReadOnly { patterns: params.read_only_parameters.clone() }
+    }
+
+    /// Why `name` may not be changed while the node runs; `None` when it may.
+    pub(crate) fn reason(&self, name: &str) -> Option<String> {
+        if FIXED.contains(&name) {
+            return Some(format!("parameter '{name}' is read-only while the node runs (it shapes the node's topics)"));
+        }
+        let pattern = self.patterns.iter().find(|p| glob_match(p, name))?;
+        Some(format!("parameter '{name}' is read-only: read_only_parameters names it ('{pattern}')"))
+    }
+}
 
 /// Every parameter with its ROS 2 value. An empty list takes its element type from
 /// [`Params::array_kinds`] (JSON cannot tell an empty list of numbers from one of strings).
@@ -62,22 +86,23 @@ pub(crate) fn to_json(value: &ParameterValue) -> Value {
 /// set-parameters service only validates (it runs in the spinner's task); the loop rebuilds.
 pub(crate) fn parameter_options(params: &Params, changes: smol::channel::Sender<Params>) -> NodeOptions {
     let accepted = Arc::new(Mutex::new(params.clone()));
+    let read_only = ReadOnly::of(params);
     let action = move |name: &str, value: &ParameterValue| -> Result<(), String> {
         let mut current = accepted.lock().map_err(|_| "parameter state poisoned".to_string())?;
         let fresh = current.with_value(name, to_json(value)).map_err(|e| e.to_string())?;
         if fresh == *current {
             return Ok(());
         }
-        if READ_ONLY.contains(&name) {
-            return Err(format!("parameter '{name}' is read-only while the node runs (it shapes the node's topics)"));
+        if let Some(reason) = read_only.reason(name) {
+            return Err(reason);
         }
         changes.try_send(fresh.clone()).map_err(|_| "the node is shutting down".to_string())?;
         *current = fresh;
         Ok(())
     };
-    // ros2-client serves the parameter services with the enhanced mapping only; with another the
-    // node serves them itself (param_services.rs).
-    let mut options = NodeOptions::new().enable_rosout(true).start_parameter_services(params.service_mapping == ServiceMapping::Enhanced);
+    // The node serves the parameter services itself (param_services.rs): ros2-client's serve
+    // the enhanced mapping only, and describe every parameter as writable.
+    let mut options = NodeOptions::new().enable_rosout(true).start_parameter_services(false);
     for (name, value) in declarations(params) {
         options = options.declare_parameter(&name, value);
     }
