@@ -95,21 +95,10 @@ fn a_closed_description_door_ignores_a_published_robot() {
                    "stamp": k})
         })
         .collect();
-    let file = dir.join("states.jsonl");
-    std::fs::write(&file, states.iter().map(Value::to_string).collect::<Vec<_>>().join("\n") + "\n").unwrap();
     let fat = dir.join("fat_arm.urdf");
     std::fs::write(&fat, common::fat_arm_urdf()).unwrap();
-    let check = |robot: Option<&std::path::Path>| -> Vec<Value> {
-        let mut c = Command::new(env!("CARGO_BIN_EXE_thickness_collision"));
-        let _ = c.args(["check", "--states", file.to_str().unwrap(), "--json"]);
-        if let Some(r) = robot {
-            let _ = c.args(["--robot", r.to_str().unwrap()]);
-        }
-        let o = c.output().unwrap();
-        assert!(o.status.success());
-        String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect()
-    };
-    let (thin, fat_ref) = (check(None), check(Some(&fat)));
+    let thin = common::check_json(&dir, "thin", &states, &[]);
+    let fat_ref = common::check_json(&dir, "fat", &states, &["--robot", fat.to_str().unwrap()]);
     let colliding = |v: &[Value]| v.iter().filter(|r| r["in_collision"] == true).count();
     assert_ne!(colliding(&thin), colliding(&fat_ref), "the two robots must answer differently");
 

@@ -5,33 +5,19 @@
 //! 150 MiB (the test's own meshes and messages, the workcell, the allocator's slack): cells of
 //! replaced objects are freed, and no copy of an object's cells is kept per scene change.
 
+mod common;
+
 #[path = "../benches/wall_1m.rs"]
 mod wall_1m;
 
 use thickness_collision::fuzz_access::{apply_collision_object_cdr, collision_object_cdr};
 use thickness_collision::model::Params;
 use thickness_collision::pipeline::Pipeline;
-use thickness_collision::thickness::ThicknessCell;
-
-fn rss() -> u64 {
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    status.lines().find(|l| l.starts_with("VmRSS:")).and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse::<u64>().ok()).unwrap_or(0) * 1024
-}
-
-/// Bytes of the cells and trees of the scene's thin surfaces.
-fn cells_bytes(p: &Pipeline) -> u64 {
-    p.checker()
-        .scene()
-        .objects()
-        .iter()
-        .map(|o| o.area().map_or(0, |a| a.cells.capacity() * std::mem::size_of::<ThicknessCell>()) + o.bvh_memory())
-        .sum::<usize>() as u64
-}
 
 #[test]
 fn large_objects_keep_memory_bounded_by_their_cells() {
     let mut p = Pipeline::new(Params::default()).unwrap();
-    let base = rss();
+    let base = common::resident_bytes("self");
     let (h, mib) = (std::f64::consts::FRAC_1_SQRT_2, 1024.0 * 1024.0);
     let mut worst: f64 = 0.0;
     let mut peak_cells = 0;
@@ -45,7 +31,7 @@ fn large_objects_keep_memory_bounded_by_their_cells() {
             let id = format!("scan_{k}");
             let add = collision_object_cdr(&id, 0, [0.6 + 0.3 * k as f64, -3.5, 3.5, 0.0, h, 0.0, h], Some((&v, &t)));
             apply_collision_object_cdr(&mut p, &add).unwrap();
-            let (now, cells) = (rss().saturating_sub(base), cells_bytes(&p));
+            let (now, cells) = (common::resident_bytes("self").saturating_sub(base), common::cells_bytes(&p));
             peak_cells = peak_cells.max(cells);
             let bound = 2.5 * cells as f64 + 150.0 * mib;
             worst = worst.max(now as f64 / bound);

@@ -18,23 +18,6 @@ use common::start_node;
 use thickness_collision::fuzz_access::{apply_planning_scene_cdr, collision_object_cdr};
 use thickness_collision::model::Params;
 use thickness_collision::pipeline::Pipeline;
-use thickness_collision::thickness::ThicknessCell;
-
-/// Resident bytes of process `pid`.
-fn rss(pid: u32) -> u64 {
-    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
-    status.lines().find(|l| l.starts_with("VmRSS:")).and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse::<u64>().ok()).unwrap_or(0) * 1024
-}
-
-/// Bytes of the cells and trees of the scene's thin surfaces (each object's own: no two share).
-fn cells_bytes(p: &Pipeline) -> u64 {
-    p.checker()
-        .scene()
-        .objects()
-        .iter()
-        .map(|o| o.area().map_or(0, |a| a.cells.capacity() * std::mem::size_of::<ThicknessCell>()) + o.bvh_memory())
-        .sum::<usize>() as u64
-}
 
 #[test]
 fn the_nodes_memory_stays_bounded_by_its_cells_under_large_adds() {
@@ -50,7 +33,7 @@ fn the_nodes_memory_stays_bounded_by_its_cells_under_large_adds() {
     let warm = peer.send(&serde_json::json!({"cmd": "apply", "service": "apply_planning_scene", "files": [], "timeout": 30}));
     assert_eq!(warm["matched"], true, "{warm}");
     std::thread::sleep(std::time::Duration::from_millis(300));
-    let base = rss(pid);
+    let base = common::resident_bytes(&pid.to_string());
     assert!(base > 0, "no VmRSS for the node (pid {pid})");
     let (mut worst, mut peak_cells, mut seconds, mut after_round) = (0.0f64, 0u64, Vec::new(), Vec::new());
     for round in 0..3 {
@@ -69,14 +52,14 @@ fn the_nodes_memory_stays_bounded_by_its_cells_under_large_adds() {
             assert_eq!(answer["success"], true, "round {round}, {id}: {a}");
             seconds.push(answer["seconds"].as_f64().unwrap_or(f64::NAN));
             thickness_collision::fuzz_access::apply_collision_object_cdr(&mut mirror, &collision_object_cdr(&id, 0, pose, Some((&v, &t)))).unwrap();
-            let (grown, cells) = (rss(pid).saturating_sub(base), cells_bytes(&mirror));
+            let (grown, cells) = (common::resident_bytes(&pid.to_string()).saturating_sub(base), common::cells_bytes(&mirror));
             peak_cells = peak_cells.max(cells);
             let bound = 2.5 * cells as f64 + 150.0 * mib;
             worst = worst.max(grown as f64 / bound);
             eprintln!("round {round}, {id}: node RSS +{:.0} MiB, cells {:.0} MiB, bound {:.0} MiB", grown as f64 / mib, cells as f64 / mib, bound / mib);
             assert!(grown as f64 <= bound, "the node's RSS grew by {:.0} MiB, past 2.5 x {:.0} MiB of cells + 150 MiB", grown as f64 / mib, cells as f64 / mib);
         }
-        after_round.push(rss(pid));
+        after_round.push(common::resident_bytes(&pid.to_string()));
     }
     // The bound above leaves room for a leak of a few objects; replaced cells must really go: two
     // more rounds of four 27 MiB objects add at most 64 MiB (a kept copy per request adds 216).

@@ -39,7 +39,7 @@ fn sheet_at(x: f64, y: f64, z: f64) -> CollisionObject {
 }
 
 /// Random states of the bundled arm, and the pipeline's reports for them.
-fn reports(p: &Pipeline) -> Vec<(bool, Vec<(String, String)>)> {
+pub(super) fn reports(p: &Pipeline) -> Vec<(bool, Vec<(String, String)>)> {
     let names: Vec<String> = ARM.iter().map(|s| s.to_string()).collect();
     let mut rng = oorandom::Rand64::new(5);
     (0..150)

@@ -11,12 +11,15 @@ use std::process::{Child, ChildStdout, Command, Stdio};
 mod bundled_arm;
 pub mod netns;
 mod scaffold;
+mod scene_memory;
 
 // Each test binary uses some of these.
 #[allow(unused_imports)]
 pub use self::bundled_arm::{arm_srdfs, arm_with_tray, random_arm_states};
 #[allow(unused_imports)]
 pub use self::scaffold::{emptied, mesh_area, scratch_dir, scratch_subdir, thin_area, topology, topology_area, write_le, LeBytes};
+#[allow(unused_imports)]
+pub use self::scene_memory::{cells_bytes, resident_bytes};
 
 /// A Cyclone DDS configuration that keeps a peer on loopback: `NetworkInterface 127.0.0.1`, no
 /// multicast, the peer 127.0.0.1 (the network rule in the design notes).
