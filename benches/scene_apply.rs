@@ -19,14 +19,9 @@ use serde_json::{json, Value};
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, Command, Stdio};
 use thickness_collision::fuzz_access::apply_planning_scene_cdr;
-use wall_1m::{checksum, wall};
+use wall_1m::{median, scene_bench_wall};
 
 const DOMAIN: &str = "175";
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 /// `command` killed with this process: a benchmark that panics leaves no node serving its
 /// domain (a second node there would answer, and build, every request too).
@@ -82,14 +77,7 @@ fn start_peer() -> Child {
 }
 
 fn main() {
-    let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
-    let nx = args.first().copied().unwrap_or(224);
-    let ny = args.get(1).copied().unwrap_or(nx);
-    let repeat = args.get(2).copied().unwrap_or(7);
-    let (v, t) = wall(nx, ny);
-    let (cv, ct) = checksum(&v, &t);
-    eprintln!("wall: {} vertices, {} triangles", v.len(), t.len());
-    eprintln!("checksum: vertices={cv:016x} triangles={ct:016x}");
+    let ((v, t), repeat) = scene_bench_wall();
     let h = std::f64::consts::FRAC_1_SQRT_2;
     let pose = [0.6, -3.5, 3.5, 0.0, h, 0.0, h];
     let dir = std::env::temp_dir().join(format!("tc_scene_apply_{}", std::process::id()));

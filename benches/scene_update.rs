@@ -16,22 +16,10 @@ use std::time::Instant;
 use thickness_collision::fuzz_access::{apply_collision_object_cdr, collision_object_cdr};
 use thickness_collision::model::Params;
 use thickness_collision::pipeline::Pipeline;
-use wall_1m::{checksum, wall};
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
+use wall_1m::{median, scene_bench_wall};
 
 fn main() {
-    let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
-    let nx = args.first().copied().unwrap_or(224);
-    let ny = args.get(1).copied().unwrap_or(nx);
-    let repeat = args.get(2).copied().unwrap_or(7);
-    let (v, t) = wall(nx, ny);
-    let (cv, ct) = checksum(&v, &t);
-    eprintln!("wall: {} vertices, {} triangles", v.len(), t.len());
-    eprintln!("checksum: vertices={cv:016x} triangles={ct:016x}");
+    let ((v, t), repeat) = scene_bench_wall();
     // The wall upright in front of the arm, 0.6 m away (a quarter turn about y).
     let (h, id) = (std::f64::consts::FRAC_1_SQRT_2, "scan");
     let at = |x: f64| [x, -3.5, 3.5, 0.0, h, 0.0, h];

@@ -22,3 +22,24 @@ pub fn checksum(v: &[Vector], t: &[[u32; 3]]) -> (u64, u64) {
     let ct = t.iter().flatten().enumerate().fold(0u64, |s, (k, &i)| s.wrapping_add((i as u64).wrapping_mul(2 * k as u64 + 1)));
     (cv, ct)
 }
+
+/// The planning-scene benchmarks' wall and repeat count from `[NX NY REPEAT]` on the command line
+/// (default 224 x 224 quads, 7 repeats), its size and checksum printed for
+/// `benches/run_scene_comparison.sh` to compare with coal's.
+pub fn scene_bench_wall() -> (generate::Soup, usize) {
+    let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
+    let nx = args.first().copied().unwrap_or(224);
+    let ny = args.get(1).copied().unwrap_or(nx);
+    let repeat = args.get(2).copied().unwrap_or(7);
+    let (v, t) = wall(nx, ny);
+    let (cv, ct) = checksum(&v, &t);
+    eprintln!("wall: {} vertices, {} triangles", v.len(), t.len());
+    eprintln!("checksum: vertices={cv:016x} triangles={ct:016x}");
+    ((v, t), repeat)
+}
+
+/// The median of `v` (not empty).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}

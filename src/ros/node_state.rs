@@ -127,9 +127,8 @@ impl NodeState {
             Event::ValidityDone(id, answer, reason) => self.send_validity_answer(io, id, answer, reason),
             // Prepared here, built without the state held, installed here (`node_run.rs`).
             Event::CollisionObject(_) | Event::AttachedObject(_) | Event::Scene(_) | Event::SceneWorld(_) | Event::ApplyScene(..) => {
-                let cells = self.take_scene_event(io, event).and_then(|pending| self.finish_scene(io, pending.build()));
-                if cells.is_some_and(|c| !c.publish(io)) {
-                    self.on_cells_failed(io);
+                if self.take_scene_event(io, event).and_then(|pending| self.finish_scene(io, pending.build())).is_some() {
+                    self.publish_cells(io);
                 }
             }
             Event::GetScene(id, req) => self.on_get_scene(io, id, req),
