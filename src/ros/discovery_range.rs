@@ -4,7 +4,7 @@
 //!
 //! | environment | participant |
 //! |---|---|
-//! | `ROS_LOCALHOST_ONLY=1` | loopback only (`with_only_networks(127.0.0.1)`); the range and the static peers are ignored, as rcl ignores them (deprecated, still honoured) |
+//! | `ROS_LOCALHOST_ONLY=1` | loopback only (`with_only_networks(127.0.0.1)`: the patched RustDDS then binds every socket to 127.0.0.1, opens no multicast socket and drops datagrams from other addresses); the range and the static peers are ignored, as rcl ignores them (deprecated, still honoured) |
 //! | range `LOCALHOST` | loopback only; static peers are refused (see below) |
 //! | range `SUBNET` (the default when unset, as in rcl) | all interfaces, multicast discovery, plus unicast discovery to each static peer |
 //! | range `SYSTEM_DEFAULT` | RustDDS's own defaults (the same as `SUBNET`), plus the static peers |

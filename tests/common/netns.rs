@@ -9,6 +9,7 @@
 //! until the guard is dropped, so tests in one binary take turns.
 
 use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
 /// Serialises the tests of one binary: the namespace names carry only the pid.
@@ -43,7 +44,8 @@ fn ip(args: &[&str]) -> Result<String, String> {
 fn remove_stale() {
     let Ok(list) = ip(&["netns", "list"]) else { return };
     for name in list.lines().filter_map(|l| l.split_whitespace().next()) {
-        let Some(pid) = name.strip_prefix("tc-a-").or_else(|| name.strip_prefix("tc-b-")) else { continue };
+        let Some(rest) = name.strip_prefix("tc-a-").or_else(|| name.strip_prefix("tc-b-")).or_else(|| name.strip_prefix("tc-l-")) else { continue };
+        let pid = rest.split('-').next().unwrap_or_default();
         if pid.parse::<u32>().is_ok() && !std::path::Path::new(&format!("/proc/{pid}")).exists() {
             let _ = ip(&["netns", "del", name]);
         }
@@ -126,6 +128,63 @@ impl Drop for TwoHosts {
             if let Err(e) = ip(&["netns", "del", ns]) {
                 eprintln!("netns guard: {e}");
             }
+        }
+    }
+}
+
+/// The second address [`LoopbackHost`] puts on `lo` (TEST-NET-2, never routed).
+pub const SECOND_ADDRESS: &str = "198.51.100.7";
+
+/// One host with two addresses and no network: namespace `tc-l-<pid>-<n>` whose only interface
+/// is `lo`, up, with 127.0.0.1 and [`SECOND_ADDRESS`]/32. A participant bound to the second
+/// address is another process of the same host that is not on loopback. Deleted on drop.
+pub struct LoopbackHost {
+    /// The namespace's name.
+    pub ns: String,
+}
+
+impl LoopbackHost {
+    /// Creates the host; panics with the reason when it cannot (namespaces need root).
+    pub fn new() -> LoopbackHost {
+        static NEXT: AtomicUsize = AtomicUsize::new(0);
+        remove_stale();
+        let host = LoopbackHost { ns: format!("tc-l-{}-{}", std::process::id(), NEXT.fetch_add(1, Ordering::Relaxed)) };
+        let build = || -> Result<(), String> {
+            let _ = ip(&["netns", "del", &host.ns]);
+            ip(&["netns", "add", &host.ns])?;
+            ip(&["-n", &host.ns, "link", "set", "lo", "up"])?;
+            ip(&["-n", &host.ns, "addr", "add", &format!("{SECOND_ADDRESS}/32"), "dev", "lo"])?;
+            let links = ip(&["-n", &host.ns, "-o", "link", "show"])?;
+            if links.lines().count() != 1 {
+                return Err(format!("{} has more than lo: {links}", host.ns));
+            }
+            Ok(())
+        };
+        if let Err(e) = build() {
+            panic!("cannot create the test host (network namespaces need root; CI runs as root): {e}");
+        }
+        host
+    }
+
+    /// The wrapper that runs a command in the host: `ip netns exec tc-l-<pid>-<n>`.
+    pub fn wrapper(&self) -> Vec<String> {
+        vec!["ip".into(), "netns".into(), "exec".into(), self.ns.clone()]
+    }
+
+    /// The local addresses (`address:port`) of every UDP socket process `pid` has open in the
+    /// host, as `ss -ulnpH` lists them.
+    pub fn udp_sockets_of(&self, pid: u32) -> Vec<String> {
+        let out = Command::new("ip").args(["netns", "exec", &self.ns, "ss", "-uanpH"]).output().expect("run ss");
+        assert!(out.status.success(), "ss failed: {}", String::from_utf8_lossy(&out.stderr));
+        let tag = format!("pid={pid},");
+        String::from_utf8_lossy(&out.stdout).lines().filter(|l| l.contains(&tag)).filter_map(|l| l.split_whitespace().nth(3).map(str::to_owned)).collect()
+    }
+}
+
+impl Drop for LoopbackHost {
+    fn drop(&mut self) {
+        if let Err(e) = ip(&["netns", "del", &self.ns]) {
+            eprintln!("netns guard: {e}");
         }
     }
 }

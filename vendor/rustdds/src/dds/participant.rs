@@ -37,7 +37,7 @@ use crate::{
     discovery_db::DiscoveryDB,
     sedp_messages::{DiscoveredReaderData, DiscoveredTopicData, DiscoveredWriterData},
   },
-  network::{constant::*, udp_listener::UDPListener},
+  network::{constant::*, udp_listener::UDPListener, udp_sender::is_loopback_only},
   polling::{
     ready_channel, wake_channel, wake_channel_unbounded, LoopWaker, ReadySender, WakeReceiver,
     WakeSender, WakeUnboundedSender,
@@ -1298,17 +1298,38 @@ impl DomainParticipantInner {
 
     let mut listeners = HashMap::new();
 
-    match UDPListener::new_multicast_with_buf_size(
-      "0.0.0.0",
-      spdp_well_known_multicast_port(domain_id),
-      Ipv4Addr::new(239, 255, 0, 1),
-      socket_receive_buffer_size,
-      only_networks.as_deref(),
-    ) {
-      Ok(l) => {
+    // thickness_collision patch (change 14): with only loopback networks, every socket is bound
+    // to 127.0.0.1, there are no multicast listeners, and datagrams from other addresses are
+    // dropped.
+    let loopback_only = is_loopback_only(only_networks.as_deref());
+    let unicast_host = if loopback_only { "127.0.0.1" } else { "0.0.0.0" };
+    let unicast_listener = |port: u16| {
+      UDPListener::new_unicast_with_buf_size(unicast_host, port, socket_receive_buffer_size).map(
+        |l| {
+          if loopback_only {
+            l.loopback_sources_only()
+          } else {
+            l
+          }
+        },
+      )
+    };
+
+    let multicast = (!loopback_only).then(|| {
+      UDPListener::new_multicast_with_buf_size(
+        "0.0.0.0",
+        spdp_well_known_multicast_port(domain_id),
+        Ipv4Addr::new(239, 255, 0, 1),
+        socket_receive_buffer_size,
+        only_networks.as_deref(),
+      )
+    });
+    match multicast {
+      None => {}
+      Some(Ok(l)) => {
         listeners.insert(DISCOVERY_MUL_LISTENER_TOKEN, l);
       }
-      Err(e) => warn!("Cannot get multicast discovery listener: {e:?}"),
+      Some(Err(e)) => warn!("Cannot get multicast discovery listener: {e:?}"),
     }
 
     let mut participant_id = 0;
@@ -1318,12 +1339,7 @@ impl DomainParticipantInner {
     // Magic value 120 below is from RTPS spec 2.5 Section "9.6.2.3 Default Port
     // Numbers"
     while discovery_listener.is_none() && participant_id < 120 {
-      discovery_listener = UDPListener::new_unicast_with_buf_size(
-        "0.0.0.0",
-        spdp_well_known_unicast_port(domain_id, participant_id),
-        socket_receive_buffer_size,
-      )
-      .ok();
+      discovery_listener = unicast_listener(spdp_well_known_unicast_port(domain_id, participant_id)).ok();
       if discovery_listener.is_none() {
         participant_id += 1;
       }
@@ -1340,29 +1356,32 @@ impl DomainParticipantInner {
 
     // Now the user traffic listeners
 
-    match UDPListener::new_multicast_with_buf_size(
-      "0.0.0.0",
-      user_traffic_multicast_port(domain_id),
-      Ipv4Addr::new(239, 255, 0, 1),
-      socket_receive_buffer_size,
-      only_networks.as_deref(),
-    ) {
-      Ok(l) => {
+    let multicast = (!loopback_only).then(|| {
+      UDPListener::new_multicast_with_buf_size(
+        "0.0.0.0",
+        user_traffic_multicast_port(domain_id),
+        Ipv4Addr::new(239, 255, 0, 1),
+        socket_receive_buffer_size,
+        only_networks.as_deref(),
+      )
+    });
+    match multicast {
+      None => {}
+      Some(Ok(l)) => {
         listeners.insert(USER_TRAFFIC_MUL_LISTENER_TOKEN, l);
       }
-      Err(e) => warn!("Cannot get multicast user traffic listener: {e:?}"),
+      Some(Err(e)) => warn!("Cannot get multicast user traffic listener: {e:?}"),
     }
 
-    let user_traffic_listener = UDPListener::new_unicast_with_buf_size(
-      "0.0.0.0",
-      user_traffic_unicast_port(domain_id, participant_id),
-      socket_receive_buffer_size,
-    )
+    let user_traffic_listener = unicast_listener(user_traffic_unicast_port(
+      domain_id,
+      participant_id,
+    ))
     .or_else(|e| {
       if matches!(e.kind(), ErrorKind::AddrInUse) {
         // If we do not get the preferred listening port,
         // try again, with "any" port number.
-        UDPListener::new_unicast_with_buf_size("0.0.0.0", 0, socket_receive_buffer_size).or_else(
+        unicast_listener(0).or_else(
           |e| {
             create_error_out_of_resources!(
               "Could not open unicast user traffic listener, any port number: {:?}",

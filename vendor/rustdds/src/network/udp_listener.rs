@@ -55,6 +55,9 @@ pub struct UDPListener {
   // Cached OS interface-index -> local interface map, used to resolve the
   // receiving interface reported by IP_PKTINFO. Built once at construction.
   ifindex_map: HashMap<u32, InterfaceSelector>,
+  // thickness_collision patch (change 14): in loopback-only mode a datagram whose source is not a
+  // loopback address (or is unknown) is dropped unread, so it is never answered.
+  loopback_sources_only: bool,
 }
 
 impl Drop for UDPListener {
@@ -166,6 +169,13 @@ impl UDPListener {
     Ok(mio_socket)
   }
 
+  /// thickness_collision patch (change 14): drop every datagram whose source is not a loopback
+  /// address.
+  pub fn loopback_sources_only(mut self) -> Self {
+    self.loopback_sources_only = true;
+    self
+  }
+
   pub fn to_locator_address(&self, only_networks: Option<&[IpAddr]>) -> io::Result<Vec<Locator>> {
     let local_port = self.socket.local_addr()?.port();
 
@@ -197,6 +207,7 @@ impl UDPListener {
       multicast_group: None,
       has_multicast_join: false,
       ifindex_map: build_ifindex_to_interface_map(),
+      loopback_sources_only: false,
     })
   }
 
@@ -262,6 +273,7 @@ impl UDPListener {
       multicast_group: Some(multicast_group),
       has_multicast_join: joined_multicast,
       ifindex_map: build_ifindex_to_interface_map(),
+      loopback_sources_only: false,
     })
   }
 
@@ -355,6 +367,13 @@ impl UDPListener {
           return messages;
         }
       };
+      // thickness_collision patch (change 14): in loopback-only mode, a datagram from any other
+      // address is dropped before anything reads it.
+      if self.loopback_sources_only && !origin.source.is_some_and(|a| a.ip().is_loopback()) {
+        self.receive_buffer.clear();
+        debug!("dropped a datagram from {:?}: loopback-only participant", origin.source);
+        continue;
+      }
       // Something was received.
       // The buffer length is still MAX_MESSAGE_SIZE, set before the receive so
       // the kernel had room to write into. Shrink it back to the number of bytes

@@ -40,6 +40,17 @@ pub struct UDPSender {
   // sent immediately. Drained on write readiness by `flush_control`.
   // (see src/rtps/nonblocking_transmit_design.md)
   control_queues: RefCell<HashMap<SocketId, ControlQueue>>,
+
+  // thickness_collision patch (change 14): every address in `only_networks` is loopback, so the
+  // unicast socket is bound to 127.0.0.1, there are no multicast sockets, and nothing is sent to
+  // an address that is not loopback.
+  loopback_only: bool,
+}
+
+/// thickness_collision patch (change 14): a participant whose `only_networks` are all loopback
+/// addresses keeps every socket on loopback.
+pub(crate) fn is_loopback_only(only_networks: Option<&[IpAddr]>) -> bool {
+  only_networks.is_some_and(|n| !n.is_empty() && n.iter().all(IpAddr::is_loopback))
 }
 
 impl UDPSender {
@@ -78,8 +89,15 @@ impl UDPSender {
     only_networks: Option<&[IpAddr]>,
     send_buffer_size: usize,
   ) -> io::Result<Self> {
+    let loopback_only = is_loopback_only(only_networks);
     let unicast_socket = {
-      let saddr: SocketAddr = SocketAddr::new("0.0.0.0".parse().unwrap(), sender_port);
+      // thickness_collision patch (change 14): loopback only binds loopback.
+      let bind_ip = if loopback_only {
+        IpAddr::from([127, 0, 0, 1])
+      } else {
+        IpAddr::from([0, 0, 0, 0])
+      };
+      let saddr: SocketAddr = SocketAddr::new(bind_ip, sender_port);
       let raw_socket = Socket::new(Domain::IPV4, Type::DGRAM, Some(Protocol::UDP))?;
       Self::set_and_verify_send_buffer(&raw_socket, send_buffer_size);
       raw_socket.bind(&SockAddr::from(saddr))?;
@@ -98,7 +116,14 @@ impl UDPSender {
       });
 
     let mut multicast_sockets = Vec::with_capacity(1);
-    for multicast_if_ipaddr in get_local_multicast_ip_addrs_filtered(only_networks)? {
+    // thickness_collision patch (change 14): no multicast in loopback-only mode; local
+    // participants are found by unicast to the well-known ports on 127.0.0.1.
+    let multicast_ifs = if loopback_only {
+      Vec::new()
+    } else {
+      get_local_multicast_ip_addrs_filtered(only_networks)?
+    };
+    for multicast_if_ipaddr in multicast_ifs {
       // beef: specify output interface
       trace!("UDPSender: Multicast sender on interface {multicast_if_ipaddr:?}");
 
@@ -162,6 +187,7 @@ impl UDPSender {
       unicast_socket: Arc::new(unicast_socket),
       multicast_sockets,
       control_queues: RefCell::new(HashMap::new()),
+      loopback_only,
     };
     info!("UDPSender::new() --> {sender:?}");
     Ok(sender)
@@ -187,6 +213,12 @@ impl UDPSender {
     Arc::clone(&self.unicast_socket)
   }
 
+  /// thickness_collision patch (change 14): whether this sender may send to `addr` at all (in
+  /// loopback-only mode, only to loopback addresses).
+  pub(crate) fn may_send_to(&self, addr: SocketAddr) -> bool {
+    !self.loopback_only || addr.ip().is_loopback()
+  }
+
   /// All sender sockets, so `DPEventLoop` can arm write readiness on each.
   pub(crate) fn socket_ids(&self) -> Vec<SocketId> {
     let mut v = vec![SocketId::Unicast];
@@ -208,6 +240,9 @@ impl UDPSender {
   /// announce locators we cannot reach (a remote IPv6 locator, or our own
   /// IPv6 interface addresses seen via loopback discovery), so this is normal.
   fn socket_can_reach(&self, id: SocketId, addr: SocketAddr) -> bool {
+    if !self.may_send_to(addr) {
+      return false;
+    }
     match id {
       SocketId::Unicast => addr.is_ipv4(),
       SocketId::Multicast(i) => match self.multicast_sockets.get(i) {
@@ -224,7 +259,7 @@ impl UDPSender {
       return SendOutcome::Dropped;
     };
     if !self.socket_can_reach(id, addr) {
-      trace!("raw_send: {id:?} cannot reach {addr} (address family mismatch), dropping");
+      trace!("raw_send: {id:?} cannot reach {addr} (address family mismatch, or not loopback in loopback-only mode), dropping");
       return SendOutcome::Dropped;
     }
     match socket.send_to(buffer, addr) {

@@ -2188,6 +2188,11 @@ impl Writer {
       if address.ip().is_multicast() {
         return None;
       }
+      // thickness_collision patch (change 14): a destination this participant may not send to is
+      // left to the Writer's path, which drops it.
+      if !self.udp_sender.may_send_to(address) {
+        return None;
+      }
       if !destinations.contains(&address) {
         destinations.push(address);
       }
