@@ -22,7 +22,7 @@ use crate::model::Srdf;
 use crate::msgs::planning_scene::{
     ApplyPlanningSceneRequest, CollisionObject, GetPlanningSceneRequest, GetPlanningSceneResponse, PlanningScene, PlanningSceneWorld,
 };
-use crate::msgs::{CollisionReport, JointState, JointTrajectory};
+use crate::msgs::{CheckTrajectoryRequest, CollisionReport, JointState};
 use crate::pipeline::{Pipeline, TrajectoryJob};
 use crate::replay::{decode_cdr, encode_cdr_le};
 use serde::{de::DeserializeOwned, Serialize};
@@ -44,7 +44,7 @@ pub trait PipelineAccess {
     fn check_request(&self, states: &[JointState]) -> Vec<CollisionReport>;
     /// A `check_trajectory` request validated and resolved as the node does before its worker
     /// runs it.
-    fn trajectory_job(&self, trajectory: &JointTrajectory) -> TrajectoryJob;
+    fn trajectory_job(&self, request: &CheckTrajectoryRequest) -> TrajectoryJob;
     /// A `check_state_validity` request answered on this thread: the response, and why the
     /// request could not be honoured.
     fn check_validity(&self, req: &GetStateValidityRequest) -> (GetStateValidityResponse, Option<String>);
@@ -55,8 +55,8 @@ impl PipelineAccess for Pipeline {
         Pipeline::check_request(self, states)
     }
 
-    fn trajectory_job(&self, trajectory: &JointTrajectory) -> TrajectoryJob {
-        Pipeline::trajectory_job(self, trajectory)
+    fn trajectory_job(&self, request: &CheckTrajectoryRequest) -> TrajectoryJob {
+        Pipeline::trajectory_job(self, request)
     }
 
     fn check_validity(&self, req: &GetStateValidityRequest) -> (GetStateValidityResponse, Option<String>) {

@@ -48,8 +48,9 @@ enum Command {
     Check {
         #[command(flatten)]
         model: ModelArgs,
-        /// One state: `joint=value,joint=value,...` (radians / metres).
-        #[arg(long, conflicts_with = "states", required_unless_present_any = ["states", "show_params"])]
+        /// One state: `joint=value,joint=value,...` (radians / metres). With `--trajectory`, the
+        /// state the robot is in when the trajectory starts (at rest).
+        #[arg(long, conflicts_with = "states", required_unless_present_any = ["states", "show_params", "trajectory"])]
         joints: Option<String>,
         /// A JSON-lines file of states, in order, through the node's pipeline: `{"name": [...],
         /// "position": [...]}` or `{"transforms": [{"link": ..., "translation": [x,y,z],
@@ -67,6 +68,20 @@ enum Command {
         /// Print the parameters in force as a ROS 2 parameters file and exit.
         #[arg(long)]
         show_params: bool,
+        /// One `trajectory_msgs/JointTrajectory` (YAML or JSON with the message's field names, as
+        /// `ros2 topic echo --once` prints it), checked as `joint_trajectory_controller` executes
+        /// it, from `--joints` (else from its first point, at rest). Exit 0 free or colliding, 2
+        /// when it is refused or cannot be read.
+        #[arg(long, conflicts_with = "states")]
+        trajectory: Option<PathBuf>,
+        /// With `--trajectory`: `spline` (the default: as the controller executes it) or
+        /// `linear` (the straight chords between the waypoints).
+        #[arg(long, requires = "trajectory", default_value = "spline")]
+        interpolation: String,
+        /// With `--trajectory`: how far each joint may stray from the path, one value per
+        /// `joint_names` entry, comma-separated (radians / metres).
+        #[arg(long, requires = "trajectory", value_delimiter = ',')]
+        path_tolerance: Vec<f64>,
     },
     /// Run the ROS 2 node (on the bundled workcell by default).
     #[cfg(feature = "ros")]
@@ -161,9 +176,10 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Areas { mesh, thickness, side, scale, json } => cli::areas::areas(mesh, thickness, side, &scale, json),
-        Command::Check { model, joints, states, json, motion, show_params } => {
-            cli::check::check(&model, &cli::check::CheckRequest { joints: joints.as_deref(), states: states.as_deref(), json, motion, show_params })
-        }
+        Command::Check { model, joints, states, json, motion, show_params, trajectory, interpolation, path_tolerance } => match trajectory {
+            Some(file) => cli::trajectory::check_trajectory(&model, &file, joints.as_deref(), &interpolation, path_tolerance, json),
+            None => cli::check::check(&model, &cli::check::CheckRequest { joints: joints.as_deref(), states: states.as_deref(), json, motion, show_params }),
+        },
         #[cfg(feature = "ros")]
         Command::Run { model, ros_args } => cli::run::run(&model, &ros_args),
         Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, no_markers, plot, jsonl, start, end, motion, no_motion } => {

@@ -15,11 +15,8 @@
 mod common;
 
 use oorandom::Rand64;
-use parry3d_f64::query;
-use parry3d_f64::shape::ConvexPolyhedron;
-use thickness_collision::checker::{Checker, ObjectType};
-use thickness_collision::collision::{ObjectBody, TargetShape};
-use thickness_collision::math::pose_from_isometry;
+use thickness_collision::checker::Checker;
+use thickness_collision::collision::TargetShape;
 use thickness_collision::model::{InputFiles, Params};
 
 const REACH: f64 = 1.2;
@@ -96,44 +93,9 @@ fn motions_agree_with_dense_sampling() {
         // A near miss: the named link came within the tolerance of the named object.
         near_misses += 1;
         let contact = r.report.contacts.first().unwrap_or_else(|| panic!("motion {m}: colliding without a contact"));
-        let ti = c.targets().iter().position(|t| t.name == contact.link_name).unwrap();
-        let hull = |shape: &TargetShape| match shape {
-            TargetShape::Polytope(h) => h.as_parry().clone(),
-            other => panic!("Panda links are meshes, not {other:?}"),
-        };
-        let mut nearest = f64::INFINITY;
         let k0 = ((f * n as f64).floor() as usize).saturating_sub(1);
-        if contact.object_type == ObjectType::RobotLink {
-            // A self pair: parry's distance between the two links' parts at the samples.
-            let tj = c.targets().iter().position(|t| t.name == contact.object_name).unwrap();
-            for k in k0..=(k0 + 3).min(n) {
-                let poses = robot.forward_kinematics(&at(k as f64 / n as f64), c.base_pose()).unwrap();
-                let (pa, pb) = (pose_from_isometry(&poses[c.targets()[ti].link]), pose_from_isometry(&poses[c.targets()[tj].link]));
-                for (sa, oa) in &c.targets()[ti].parts {
-                    for (sb, ob) in &c.targets()[tj].parts {
-                        let d = query::distance(&(pa * *oa), &hull(sa), &(pb * *ob), &hull(sb)).unwrap();
-                        nearest = nearest.min(d.distance);
-                    }
-                }
-            }
-        } else {
-            let object = c.scene().objects().iter().find(|o| o.name == contact.object_name).unwrap();
-            let other: Box<dyn parry3d_f64::shape::Shape> = match &*object.body {
-                ObjectBody::Surface { area, .. } => {
-                    let cell = area.cells.iter().find(|cell| cell.triangle == contact.triangle).unwrap();
-                    Box::new(ConvexPolyhedron::from_convex_hull(&cell.distinct_vertices()).unwrap())
-                }
-                ObjectBody::Solid(shape) => Box::new(hull(shape)),
-            };
-            for k in k0..=(k0 + 3).min(n) {
-                let poses = robot.forward_kinematics(&at(k as f64 / n as f64), c.base_pose()).unwrap();
-                let link = pose_from_isometry(&poses[c.targets()[ti].link]);
-                for (shape, offset) in &c.targets()[ti].parts {
-                    let d = query::distance(&(link * *offset), &hull(shape), &object.pose, &*other).unwrap();
-                    nearest = nearest.min(d.distance);
-                }
-            }
-        }
+        let qs: Vec<Vec<f64>> = (k0..=(k0 + 3).min(n)).map(|k| at(k as f64 / n as f64)).collect();
+        let nearest = common::near_miss::nearest_to_contact(&c, &contact.link_name, &contact.object_name, contact.triangle, &qs);
         let tol = c.params().motion_tolerance;
         assert!(
             nearest <= tol + STEP,

@@ -88,8 +88,9 @@ fn t_ns(k: usize) -> i64 {
     1_000_000_000 + 500_000_000 * k as i64
 }
 
+/// Waypoints along the straight chords (`interpolation: linear`), as `check --motion` checks them.
 fn request_of(names: &[String], waypoints: &[Vec<f64>]) -> Value {
-    json!({"joint_names": names, "points": waypoints.iter().enumerate().map(|(k, p)| json!({"positions": p, "t": t_ns(k)})).collect::<Vec<_>>()})
+    json!({"joint_names": names, "interpolation": "linear", "points": waypoints.iter().enumerate().map(|(k, p)| json!({"positions": p, "t": t_ns(k)})).collect::<Vec<_>>()})
 }
 
 /// `check --states FILE --motion --json` on waypoints given by name.
@@ -221,6 +222,9 @@ fn check_trajectory_over_dds_equals_check_motion_and_refuses_bad_requests() {
         (json!({"joint_names": elbow_only, "points": [{"positions": [0.1], "t": 0}, {"positions": ["NaN"], "t": 1_000_000_000}]}), "non-finite"),
         (json!({"joint_names": ["elbow_joint", "no_such_joint"], "points": [{"positions": [0.1, 0.2], "t": 0}]}), "'no_such_joint' is not a joint"),
         (json!({"joint_names": elbow_only, "points": []}), "no points"),
+        (json!({"joint_names": elbow_only, "interpolation": "cubic", "points": [{"positions": [0.1], "t": 0}]}), "interpolation 'cubic' is not known"),
+        (json!({"joint_names": elbow_only, "path_tolerance": [0.1, 0.2], "points": [{"positions": [0.1], "t": 0}]}), "path_tolerance has 2 values for 1"),
+        (json!({"joint_names": elbow_only, "points": [{"positions": [0.1], "accelerations": [1.0], "t": 0}]}), "accelerations without velocities"),
     ];
 
     let domain = 1 + std::process::id() % 14;
@@ -302,4 +306,93 @@ fn a_long_trajectory_is_checked_while_the_live_stream_goes_on() {
     // state takes milliseconds; a stalled loop would hold them for the whole trajectory).
     assert!(long["latencies"].as_u64().unwrap() >= 10, "{long}");
     assert!(long["max_latency"].as_f64().unwrap() < 1.0, "the live stream stalled: {long}");
+}
+
+/// A trajectory of the bundled arm for `check --trajectory` (its JSON file) and for the peer.
+fn executed_request(names: &[String], points: &[(Vec<f64>, Vec<f64>, Vec<f64>, i64)]) -> (Value, Value) {
+    let file = json!({
+        "joint_names": names,
+        "points": points.iter().map(|(p, v, a, t)| json!({"positions": p, "velocities": v, "accelerations": a,
+            "time_from_start": {"sec": t / 1_000_000_000, "nanosec": t % 1_000_000_000}})).collect::<Vec<_>>(),
+    });
+    let peer = json!({
+        "joint_names": names,
+        "points": points.iter().map(|(p, v, a, t)| json!({"positions": p, "velocities": v, "accelerations": a, "t": t})).collect::<Vec<_>>(),
+    });
+    (file, peer)
+}
+
+/// Issue 34: trajectories with velocities and accelerations, executed as the controller would
+/// from the state the node last received (published by the peer, at rest), over DDS: each answer
+/// equals `check --trajectory FILE --json --joints <that state>` (segment, fraction, time to the
+/// nanosecond, contacts), and the set has both answers and an approach.
+#[test]
+fn executed_trajectories_over_dds_equal_check_trajectory() {
+    let (dir, cyclone) = scratch("executed");
+    let arm = Arm::new();
+    let mut rng = Rand64::new(34);
+    let start = arm.free_step(&mut rng, None, 0.0);
+    let mut cases = Vec::new();
+    for k in 0..10 {
+        let mut p = start.clone();
+        let mut t = if k % 3 == 0 { 0 } else { 400_000_000 + 100_000_000 * k as i64 };
+        let points: Vec<(Vec<f64>, Vec<f64>, Vec<f64>, i64)> = (0..3)
+            .map(|_| {
+                p = arm.random(&mut rng, Some(&p), 0.5);
+                let v: Vec<f64> = p.iter().map(|_| 1.6 * rng.rand_float() - 0.8).collect();
+                let a: Vec<f64> = if k % 2 == 0 { p.iter().map(|_| 6.0 * rng.rand_float() - 3.0).collect() } else { Vec::new() };
+                let point = (p.clone(), v, a, t);
+                t += 600_000_000;
+                point
+            })
+            .collect();
+        cases.push(executed_request(&arm.names, &points));
+    }
+    let joints: String = arm.names.iter().zip(&start).map(|(n, x)| format!("{n}={x}")).collect::<Vec<_>>().join(",");
+    let cli: Vec<Value> = cases
+        .iter()
+        .enumerate()
+        .map(|(k, (file, _))| {
+            let path = dir.join(format!("trajectory_{k}.json"));
+            std::fs::write(&path, file.to_string()).unwrap();
+            let o = Command::new(env!("CARGO_BIN_EXE_thickness_collision"))
+                .args(["check", "--trajectory", path.to_str().unwrap(), "--json", "--joints", &joints])
+                .output()
+                .unwrap();
+            assert!(o.status.success(), "check --trajectory {k}: {}", String::from_utf8_lossy(&o.stderr));
+            serde_json::from_slice(&o.stdout).unwrap()
+        })
+        .collect();
+    assert!(cli.iter().any(|c| c["in_collision"] == true) && cli.iter().any(|c| c["in_collision"] == false), "both answers: {cli:?}");
+
+    let domain = 168;
+    let (node, _out, _banner) = start_node(&[], domain);
+    let state = json!({"name": arm.names, "position": start, "stamp": 5_000_000_000i64});
+    let trajectories: Vec<Value> = cases.iter().map(|(_, peer)| peer.clone()).collect();
+    let answer = common::run_cyclone_peer(
+        "trajectory_peer.py",
+        &cyclone,
+        &json!({"domain": domain, "state": state, "trajectories": trajectories, "timeout": 60}).to_string(),
+    );
+    common::stop_node(node);
+    let answers = answer["answers"].as_array().unwrap();
+    assert_eq!(answers.len(), cli.len(), "{answer}");
+    for (k, (got, want)) in answers.iter().zip(&cli).enumerate() {
+        assert_eq!(got["error"], "", "case {k}: {got}");
+        assert_eq!(got["valid"].as_bool(), want["in_collision"].as_bool().map(|c| !c), "case {k}: {got} vs {want}");
+        if got["valid"] == true {
+            continue;
+        }
+        assert_eq!(got["segment"], want["segment"], "case {k}");
+        assert_eq!(got["fraction"], want["fraction"], "case {k}");
+        let ns = got["time_from_start"].as_i64().unwrap();
+        assert!((ns as f64 * 1e-9 - want["time"].as_f64().unwrap()).abs() < 1e-9, "case {k}: {ns} ns vs {}", want["time"]);
+        let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
+        assert_eq!(g.len(), w.len(), "case {k}");
+        for (a, b) in g.iter().zip(w) {
+            for key in ["link_name", "object_name", "triangle"] {
+                assert_eq!(a[key], b[key], "case {k}: {key}");
+            }
+        }
+    }
 }

@@ -87,7 +87,7 @@ impl MotionPath for JointPath<'_> {
     /// about a point `c` of the link, plus what it can gain within `half`: every point moves at
     /// most `half · (|v_c| + |ω| R) + half² · A / 2` from where it is at `s`, with `A` the
     /// acceleration bound of `point_acceleration`. The smaller of the two bounds is used.
-    fn bound(&self, ti: usize, poses: &[Option<Pose>], half: f64) -> Real {
+    fn bound(&self, ti: usize, poses: &[Option<Pose>], _mid: f64, half: f64) -> Real {
         let robot = self.checker.robot();
         let bounds = self.checker.motion_bounds();
         let Some(link) = poses[self.checker.targets()[ti].link] else { return half * self.speeds[ti] };
@@ -144,9 +144,9 @@ impl MotionPath for JointPath<'_> {
     /// In the frame of the last link upstream of both: only the joints that move one of the two
     /// and not the other count (a joint above both turns the pair as one body). Each with its
     /// lever bound over all configurations; the world bounds when those are smaller in sum.
-    fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], half: f64) -> (Real, Real) {
-        let relative = self.pair_bound_quick(a, b, poses, half);
-        let world = (self.bound(a, poses, half), self.bound(b, poses, half));
+    fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> (Real, Real) {
+        let relative = self.pair_bound_quick(a, b, poses, mid, half);
+        let world = (self.bound(a, poses, mid, half), self.bound(b, poses, mid, half));
         if relative.0 + relative.1 <= world.0 + world.1 {
             relative
         } else {
@@ -155,7 +155,7 @@ impl MotionPath for JointPath<'_> {
     }
 
     /// The relative bounds of [`JointPath::pair_bound`] alone.
-    fn pair_bound_quick(&self, a: usize, b: usize, _poses: &[Option<Pose>], half: f64) -> (Real, Real) {
+    fn pair_bound_quick(&self, a: usize, b: usize, _poses: &[Option<Pose>], _mid: f64, half: f64) -> (Real, Real) {
         let levers = &self.checker.motion_bounds().levers;
         let own = |x: usize, y: usize| -> Real {
             levers[x].iter().filter(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).map(|(j, r)| self.delta[*j].abs() * r).sum()
@@ -215,7 +215,7 @@ impl Checker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::collision::TargetShape;
+    use crate::checker::test_points::part_points;
     use crate::model::Params;
 
     fn arm() -> Checker {
@@ -249,19 +249,6 @@ mod tests {
         assert!(c.check_motion(&free, &free).report.error.is_empty());
     }
 
-    /// Points of a part in its link's frame: a hull's vertices, a primitive's extreme points
-    /// along 26 directions.
-    fn part_points(shape: &TargetShape, offset: &Pose) -> Vec<Vector> {
-        let local: Vec<Vector> = match shape {
-            TargetShape::Polytope(h) => h.points().to_vec(),
-            _ => (0..27)
-                .filter(|&i| i != 13)
-                .map(|i| shape.support_point(Vector::new((i % 3) as Real - 1.0, ((i / 3) % 3) as Real - 1.0, (i / 9) as Real - 1.0)))
-                .collect(),
-        };
-        local.into_iter().map(|p| *offset * p).collect()
-    }
-
     /// The bound the adaptive loop trusts, checked directly: over random motions of the bundled
     /// arm (revolute, continuous, prismatic and mimic joints), no point of any link, sampled
     /// along a stretch, lies farther from where it is at the stretch's middle than the bound.
@@ -285,7 +272,7 @@ mod tests {
             let s = draw(0.0, 1.0);
             let poses = path.link_poses(s).unwrap();
             for (ti, t) in c.targets().iter().enumerate() {
-                let bound = path.bound(ti, &poses, half);
+                let bound = path.bound(ti, &poses, s, half);
                 let points: Vec<Vector> = t.parts.iter().flat_map(|(shape, offset)| part_points(shape, offset)).collect();
                 let at = poses[t.link].unwrap();
                 let mut farthest = 0.0f64;

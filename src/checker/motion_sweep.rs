@@ -47,21 +47,27 @@ pub(super) trait MotionPath {
     fn link_poses(&self, s: f64) -> Result<Vec<Option<Pose>>, String>;
     /// A bound on how far any point of target `ti` moves from where it is at `s`, for every `s'`
     /// with `|s' - s| <= half`, given the link poses at `s`. At most `half · speeds()[ti]`.
-    fn bound(&self, ti: usize, _poses: &[Option<Pose>], half: f64) -> Real {
+    fn bound(&self, ti: usize, _poses: &[Option<Pose>], _mid: f64, half: f64) -> Real {
         half * self.speeds()[ti]
     }
     /// The report of the state at `s` (its contacts are those of a motion found colliding there).
     fn report_at(&self, s: f64) -> StateReport;
+    /// The part of target `ti`'s bounds that does not shrink with the stretch (a path tolerance:
+    /// every configuration within it of the path is covered). A stretch whose bound is within
+    /// the ladder's first rung of it cannot be narrowed further.
+    fn floor(&self, _ti: usize) -> Real {
+        0.0
+    }
     /// Bounds for self pair `(a, b)` within `half` of `s`: how far each target's points move, both
     /// measured in the same frame (the world, or a frame the two share, such as the last link
     /// upstream of both: the joints above it move the pair rigidly and do not change their
     /// distance).
-    fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], half: f64) -> (Real, Real) {
-        (self.bound(a, poses, half), self.bound(b, poses, half))
+    fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> (Real, Real) {
+        (self.bound(a, poses, mid, half), self.bound(b, poses, mid, half))
     }
     /// Bounds as [`MotionPath::pair_bound`]'s, possibly looser, cheaper to find.
-    fn pair_bound_quick(&self, a: usize, b: usize, poses: &[Option<Pose>], half: f64) -> (Real, Real) {
-        self.pair_bound(a, b, poses, half)
+    fn pair_bound_quick(&self, a: usize, b: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> (Real, Real) {
+        self.pair_bound(a, b, poses, mid, half)
     }
 }
 
@@ -79,6 +85,9 @@ pub(super) struct Grown {
     pub(super) ti: usize,
     pub(super) level: Option<usize>,
     tested: bool,
+    /// Splitting the stretch cannot make the growth smaller (the first rung, or within it of
+    /// the path's floor).
+    settled: bool,
     pub(super) pose: Pose,
 }
 
@@ -108,7 +117,7 @@ impl Stretch {
         let all = |f: fn(&Grown) -> bool| f(&grown) && other.as_ref().is_none_or(f);
         if all(|g| g.tested) && !meets() {
             Stretch::Clear
-        } else if all(|g| g.level.is_none_or(|l| l == 0)) {
+        } else if all(|g| g.settled) {
             Stretch::Blocked(Blocked { fraction: start, grown, other })
         } else {
             Stretch::Split
@@ -120,13 +129,14 @@ impl Stretch {
 /// covers it, worth testing when the growth covers the bound (rounding, NaN or past the ladder's
 /// top: split) and is not beyond what is worth testing (the first rung always is). A target
 /// that does not move is tested as it is.
-fn grown_for(bounds: &MotionBounds, ti: usize, pose: Pose, delta: Real) -> Grown {
+fn grown_for(bounds: &MotionBounds, ti: usize, pose: Pose, delta: Real, floor: Real) -> Grown {
     if delta > 0.0 {
         let level = bounds.level(delta);
         let growth = bounds.growth(level);
-        Grown { ti, level: Some(level), tested: growth >= delta && (growth <= MAX_TESTED_GROWTH || level == 0), pose }
+        let settled = level == 0 || delta - floor <= bounds.growth(0);
+        Grown { ti, level: Some(level), tested: growth >= delta && (growth <= MAX_TESTED_GROWTH || settled), settled, pose }
     } else {
-        Grown { ti, level: None, tested: true, pose }
+        Grown { ti, level: None, tested: true, settled: true, pose }
     }
 }
 
@@ -223,8 +233,8 @@ impl Checker {
         let pose = poses[lt.link].ok_or_else(|| format!("no pose for link '{}'", lt.name))?;
         // A link that does not move is where it is at every s: checked as it is, ungrown (a
         // base resting on a table is not a near miss).
-        let delta = if path.speeds()[ti] > 0.0 { path.bound(ti, poses, half) } else { 0.0 };
-        let grown = grown_for(self.motion_bounds(), ti, pose, delta);
+        let delta = if path.speeds()[ti] > 0.0 { path.bound(ti, poses, start + half, half) } else { 0.0 };
+        let grown = grown_for(self.motion_bounds(), ti, pose, delta, path.floor(ti));
         let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
         Ok(Stretch::judge(start, grown, None, || self.grown_link_hit(&grown, &flags)))
     }
@@ -242,15 +252,15 @@ impl Checker {
         let bounds = self.motion_bounds();
         let ((ca, ra), (cb, rb)) = (bounds.ball[ta], bounds.ball[tb]);
         let gap = (pa * ca - pb * cb).length() - ra - rb;
-        let (quick_a, quick_b) = path.pair_bound_quick(ta, tb, poses, half);
+        let (quick_a, quick_b) = path.pair_bound_quick(ta, tb, poses, start + half, half);
         if gap > quick_a + quick_b {
             return Ok(Stretch::Clear);
         }
-        let (delta_a, delta_b) = path.pair_bound(ta, tb, poses, half);
+        let (delta_a, delta_b) = path.pair_bound(ta, tb, poses, start + half, half);
         if gap > delta_a + delta_b {
             return Ok(Stretch::Clear);
         }
-        let (a, b) = (grown_for(bounds, ta, pa, delta_a), grown_for(bounds, tb, pb, delta_b));
+        let (a, b) = (grown_for(bounds, ta, pa, delta_a, path.floor(ta)), grown_for(bounds, tb, pb, delta_b, path.floor(tb)));
         Ok(Stretch::judge(start, a, Some(b), || self.grown_pair_may_meet(&a, &b)))
     }
 }

@@ -10,7 +10,7 @@ use thickness_collision::limits::{open_regular, MAX_STATE_LINE_BYTES};
 use thickness_collision::msgs::Time;
 use thickness_collision::pipeline::{parse_state_line, CheckedState, Pipeline, RobotState, StateLine};
 
-fn parse_joints(spec: &str) -> Result<(Vec<String>, Vec<f64>)> {
+pub(super) fn parse_joints(spec: &str) -> Result<(Vec<String>, Vec<f64>)> {
     let mut names = Vec::new();
     let mut values = Vec::new();
     for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
@@ -62,7 +62,7 @@ pub fn check(args: &ModelArgs, req: &CheckRequest) -> Result<()> {
     Ok(())
 }
 
-fn print_loaded(pipeline: &Pipeline) {
+pub(super) fn print_loaded(pipeline: &Pipeline) {
     let s = pipeline.checker().summary();
     eprintln!(
         "loaded {} ({} links, {} checked) and {} ({} thin surfaces, {} cells, {} solids) in {:.1} ms",
@@ -168,6 +168,11 @@ fn emit(out: &mut impl Write, n: usize, checked: &CheckedState, json: bool) -> R
     if !report.motion {
         writeln!(out, "state {n}: IN COLLISION{limits}")?;
     }
+    print_contacts(out, report)
+}
+
+/// One line per contact of `report`.
+pub(super) fn print_contacts(out: &mut impl Write, report: &thickness_collision::checker::StateReport) -> Result<()> {
     for c in &report.contacts {
         let tri = match c.object_type {
             ObjectType::RobotLink => "robot link".to_string(),

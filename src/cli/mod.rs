@@ -6,3 +6,4 @@ mod load;
 pub mod replay;
 #[cfg(feature = "ros")]
 pub mod run;
+pub mod trajectory;

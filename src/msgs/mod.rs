@@ -386,14 +386,14 @@ pub struct JointTrajectoryPoint {
     /// Positions, one per joint name (radians or metres).
     #[serde(deserialize_with = "bounded_trajectory_seq")]
     pub positions: Vec<f64>,
-    /// Velocities (not used by the check).
-    #[serde(deserialize_with = "bounded_trajectory_seq")]
+    /// Velocities (per second), one per joint name, or none (a file may leave them out).
+    #[serde(default, deserialize_with = "bounded_trajectory_seq")]
     pub velocities: Vec<f64>,
-    /// Accelerations (not used by the check).
-    #[serde(deserialize_with = "bounded_trajectory_seq")]
+    /// Accelerations, one per joint name, or none (a file may leave them out).
+    #[serde(default, deserialize_with = "bounded_trajectory_seq")]
     pub accelerations: Vec<f64>,
-    /// Efforts (not used by the check).
-    #[serde(deserialize_with = "bounded_trajectory_seq")]
+    /// Efforts (not used by the check; a file may leave them out).
+    #[serde(default, deserialize_with = "bounded_trajectory_seq")]
     pub effort: Vec<f64>,
     /// When the point is reached, from the trajectory's start.
     pub time_from_start: DurationMsg,
@@ -402,7 +402,8 @@ pub struct JointTrajectoryPoint {
 /// `trajectory_msgs/msg/JointTrajectory`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct JointTrajectory {
-    /// Header.
+    /// Header (a file may leave it out).
+    #[serde(default)]
     pub header: Header,
     /// The joints every point gives a position for, in order.
     #[serde(deserialize_with = "bounded_trajectory_seq")]
@@ -413,10 +414,58 @@ pub struct JointTrajectory {
 }
 
 /// `thickness_collision_msgs/srv/CheckTrajectory` request.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct CheckTrajectoryRequest {
     /// The trajectory; joints it does not name keep the node's current merged state.
     pub trajectory: JointTrajectory,
+    /// How the segments are interpolated: empty, as `joint_trajectory_controller` executes them
+    /// (linear, cubic or quintic by what the points give, from the current state); `linear`, the
+    /// straight chords between the waypoints.
+    pub interpolation: String,
+    /// Per joint of `joint_names`, how far the executed path may stray (radians or metres);
+    /// empty: none.
+    pub path_tolerance: Vec<f64>,
+}
+
+/// `path_tolerance` as decoded: bounded like the trajectory's own fields.
+#[derive(Deserialize)]
+struct Tolerances(#[serde(deserialize_with = "bounded_trajectory_seq")] Vec<f64>);
+
+/// Decoded field by field so that an older client's request, which ends after `trajectory`,
+/// decodes with the two appended fields empty. A request that gives `interpolation` must give
+/// `path_tolerance` whole (else it does not decode).
+impl<'de> Deserialize<'de> for CheckTrajectoryRequest {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::{Error, MapAccess, SeqAccess, Visitor};
+        struct Fields;
+        impl<'de> Visitor<'de> for Fields {
+            type Value = CheckTrajectoryRequest;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a CheckTrajectory request")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let trajectory = seq.next_element()?.ok_or_else(|| A::Error::invalid_length(0, &self))?;
+                let Ok(Some(interpolation)) = seq.next_element::<String>() else {
+                    return Ok(CheckTrajectoryRequest { trajectory, ..Default::default() });
+                };
+                let path_tolerance = seq.next_element::<Tolerances>()?.map(|t| t.0).unwrap_or_default();
+                Ok(CheckTrajectoryRequest { trajectory, interpolation, path_tolerance })
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+                let mut r = CheckTrajectoryRequest::default();
+                while let Some(key) = map.next_key::<String>()? {
+                    match key.as_str() {
+                        "trajectory" => r.trajectory = map.next_value()?,
+                        "interpolation" => r.interpolation = map.next_value()?,
+                        "path_tolerance" => r.path_tolerance = map.next_value::<Tolerances>()?.0,
+                        other => return Err(A::Error::unknown_field(other, &["trajectory", "interpolation", "path_tolerance"])),
+                    }
+                }
+                Ok(r)
+            }
+        }
+        d.deserialize_struct("CheckTrajectoryRequest", &["trajectory", "interpolation", "path_tolerance"], Fields)
+    }
 }
 
 /// `thickness_collision_msgs/srv/CheckTrajectory` response.

@@ -11,12 +11,14 @@ const MAX_UNKNOWN_REPORTED: usize = 64;
 #[derive(Clone, Debug)]
 pub(crate) struct JointInput {
     received: Vec<Option<f64>>,
+    /// The velocity each joint was last received with (`None`: its last message gave none).
+    velocity: Vec<Option<f64>>,
 }
 
 impl JointInput {
     /// Nothing received yet for any joint of `robot`.
     pub(crate) fn new(checker: &Checker) -> JointInput {
-        JointInput { received: vec![None; checker.robot().joints.len()] }
+        JointInput { received: vec![None; checker.robot().joints.len()], velocity: vec![None; checker.robot().joints.len()] }
     }
 
     /// One message: the position of every joint, or why the message gives no state. A bad message
@@ -31,6 +33,7 @@ impl JointInput {
         missing: MissingJoint,
         names: &[String],
         positions: &[f64],
+        velocities: &[f64],
         unknown: &mut Vec<String>,
     ) -> Result<Vec<f64>, StateError> {
         let robot = checker.robot();
@@ -38,11 +41,16 @@ impl JointInput {
             return Err(StateError::Lengths { names: names.len(), positions: positions.len() });
         }
         let mut given: Vec<(usize, f64)> = Vec::with_capacity(names.len().min(robot.joints.len()));
-        for (name, &value) in names.iter().zip(positions) {
+        let mut speeds: Vec<Option<f64>> = Vec::with_capacity(given.capacity());
+        for (k, (name, &value)) in names.iter().zip(positions).enumerate() {
             match robot.joint(name) {
                 Some(_) if !value.is_finite() => return Err(StateError::NonFinite { joint: name.clone(), value }),
                 Some(j) if given.iter().any(|(k, _)| *k == j) => return Err(StateError::Duplicate(name.clone())),
-                Some(j) => given.push((j, value)),
+                Some(j) => {
+                    given.push((j, value));
+                    // A message whose velocities do not match its names gives none.
+                    speeds.push(if velocities.len() == names.len() { velocities.get(k).copied().filter(|v| v.is_finite()) } else { None });
+                }
                 // The pipeline warns about a bounded number of names; a message of made-up
                 // names must not cost a copy of each.
                 None if unknown.len() < MAX_UNKNOWN_REPORTED => unknown.push(name.clone()),
@@ -52,9 +60,11 @@ impl JointInput {
         crate::checker::require_own_joints(robot, given.iter().map(|&(j, _)| j), names)?;
         if missing == MissingJoint::Zero {
             self.received.iter_mut().for_each(|v| *v = None);
+            self.velocity.iter_mut().for_each(|v| *v = None);
         }
-        for (j, value) in given {
+        for ((j, value), speed) in given.into_iter().zip(speeds) {
             self.received[j] = Some(value);
+            self.velocity[j] = speed;
         }
         if missing == MissingJoint::Last {
             let mut lacking = (0..robot.joints.len()).filter(|&j| self.received[j].is_none() && checker.moves_checked_link(j));
@@ -78,5 +88,10 @@ impl JointInput {
     /// `missing_joint: zero`).
     pub(crate) fn current(&self) -> &[Option<f64>] {
         &self.received
+    }
+
+    /// The velocities received with [`JointInput::current`]'s positions (`None`: not given).
+    pub(crate) fn velocities(&self) -> &[Option<f64>] {
+        &self.velocity
     }
 }

@@ -22,6 +22,8 @@ mod state_line;
 mod state_pipeline;
 mod tf_tree;
 mod trajectory;
+mod trajectory_file;
+mod trajectory_plan;
 mod validity;
 
 pub use self::report_adapter::{report_message, CheckedState};
@@ -34,6 +36,9 @@ pub use self::state_pipeline::{Pipeline, RobotState};
 pub(crate) use self::link_transforms::link_transforms;
 pub(crate) use self::scene_input::{BuiltScene, ScenePlan};
 pub(crate) use self::trajectory::TrajectoryJob;
+pub use self::trajectory::{Outcome, APPROACH_SEGMENT};
+pub use self::trajectory_file::{read_trajectory_file, MAX_TRAJECTORY_FILE_BYTES};
+pub use self::trajectory_plan::Interpolation;
 #[cfg(feature = "ros")]
 pub(crate) use self::validity::ValidityJob;
 

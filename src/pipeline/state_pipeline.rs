@@ -203,7 +203,7 @@ impl Pipeline {
     pub fn joint_state(&mut self, msg: &JointState) -> Result<RobotState, Skip> {
         let mut unknown = Vec::new();
         let missing = self.params().missing_joint;
-        let result = self.joints.ingest(&self.checker, missing, &msg.name, &msg.position, &mut unknown);
+        let result = self.joints.ingest(&self.checker, missing, &msg.name, &msg.position, &msg.velocity, &mut unknown);
         for name in unknown {
             if self.unknown_names.len() < MAX_UNKNOWN_NAMES && self.unknown_names.insert(name.clone()) {
                 self.warnings.push(format!("'{name}' is not a joint of the robot model; ignored (warned once)"));
@@ -402,6 +402,12 @@ impl Pipeline {
     /// where the joint was looked for, for the error. Under `last` a joint that moves a checked
     /// link and was never received leaves the pose unknown: checking it at 0 could call a
     /// colliding request free.
+    /// The velocity joint `j` was last received with; 0 (at rest) when its last joint state gave
+    /// none or it was never received.
+    pub(crate) fn current_velocity(&self, j: usize) -> f64 {
+        self.joints.velocities()[j].unwrap_or(0.0)
+    }
+
     pub(crate) fn left_out_position(&self, j: usize, request: &str) -> Result<f64, String> {
         let joint = &self.checker.robot().joints[j];
         let missing = self.params().missing_joint;

@@ -426,7 +426,7 @@ impl NodeState {
 
     /// `check_trajectory`: resolved by the pipeline here (cheap), checked by its worker.
     fn on_trajectory_request(&mut self, io: &Interfaces, workers: &Workers, id: RmwRequestId, req: CheckTrajectoryRequest) {
-        let job = self.pipeline.trajectory_job(&req.trajectory);
+        let job = self.pipeline.trajectory_job(&req);
         drop(req);
         if let Some(answer) = workers.trajectory.take(id, job) {
             self.send_trajectory_answer(io, id, answer);

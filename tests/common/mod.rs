@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, Stdio};
 
 mod bundled_arm;
+pub mod near_miss;
 pub mod netns;
 mod scaffold;
 mod scene_memory;

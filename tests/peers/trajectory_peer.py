@@ -6,8 +6,9 @@ Loopback only: the caller sets CYCLONEDDS_URI (127.0.0.1, no multicast, peer 127
 stdin: {"domain": id, "state": {"name", "position", "stamp"} (published first, until the node
         reports on it), "trajectories": [T...], "long": T (optional), "stream": [states sent in turn,
         every "period" s (default 0.05), while the long one is checked], "timeout": s}
-        T = {"joint_names": [...], "points": [{"positions": [...], "t": ns}]}; a position may be
-        the string "NaN".
+        T = {"joint_names": [...], "points": [{"positions": [...], "velocities": [...] (optional),
+        "accelerations": [...] (optional), "t": ns}], "interpolation": "" (default) or "linear",
+        "path_tolerance": [...] (optional)}; a position may be the string "NaN".
 stdout: {"state_report": report or null, "answers": [A...], "long": {"answer": A, "seconds": s,
         "reports_before_answer": n, "states_sent": n, "max_report_gap": s,
         "max_latency": s (a report after the sending of the state it is stamped with), "latencies": n}}
@@ -46,7 +47,8 @@ def js(s):
 
 
 def trajectory(tr):
-    points = [d.JointTrajectoryPoint(positions=[float(x) for x in p["positions"]], velocities=[], accelerations=[], effort=[],
+    points = [d.JointTrajectoryPoint(positions=[float(x) for x in p["positions"]], velocities=[float(x) for x in p.get("velocities", [])],
+                                     accelerations=[float(x) for x in p.get("accelerations", [])], effort=[],
                                      time_from_start=d.DurationMsg(sec=int(p["t"]) // 1_000_000_000, nanosec=int(p["t"]) % 1_000_000_000))
               for p in tr["points"]]
     return d.JointTrajectory(header=d.Header(stamp=stamp(0), frame_id="world"), joint_names=tr["joint_names"], points=points)
@@ -77,7 +79,9 @@ while (states_w.get_matched_subscriptions() == [] or reports_r.get_matched_publi
        or resp_r.get_matched_publications() == []) and time.time() < end:
     time.sleep(0.05)
 out = {"state_report": None, "answers": [], "long": None}
-client = service_client.Client(req_w, resp_r, lambda tr, seq: d.TrajRequest(guid=GUID, seq=seq, trajectory=trajectory(tr)))
+client = service_client.Client(req_w, resp_r, lambda tr, seq: d.TrajRequest(
+    guid=GUID, seq=seq, trajectory=trajectory(tr), interpolation=tr.get("interpolation", ""),
+    path_tolerance=[float(x) for x in tr.get("path_tolerance", [])]))
 send, wait_answer = client.send, client.wait_answer
 
 

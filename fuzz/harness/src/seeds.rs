@@ -209,7 +209,7 @@ fn trajectory_seeds(out: &mut Vec<Seed>) {
     let names = workcell_joint_names();
     let point = |positions: Vec<f64>, sec: i32| JointTrajectoryPoint { positions, time_from_start: DurationMsg { sec, nanosec: 0 }, ..Default::default() };
     let request = |joint_names: Vec<String>, points: Vec<JointTrajectoryPoint>| {
-        encode_cdr_le(&CheckTrajectoryRequest { trajectory: JointTrajectory { header: header("world"), joint_names, points } })
+        encode_cdr_le(&CheckTrajectoryRequest { trajectory: JointTrajectory { header: header("world"), joint_names, points }, ..Default::default() })
     };
     let lift_elbow = vec!["shoulder_lift_joint".to_string(), "elbow_joint".to_string()];
     let wave: Vec<JointTrajectoryPoint> =

@@ -1,0 +1,296 @@
+//! A trajectory segment as the controller executes it: every joint on its own polynomial in the
+//! segment's parameter `s` (`spline_poly`), checked with the adaptive loop of the motion check
+//! (`motion_sweep`) and the same guarantee: "free" is certain for every instant of the segment,
+//! and a reported fraction is never later than the first contact.
+//!
+//! Over a stretch `[a, b]` with middle `m`, joint `j` strays from `q_j(m)` by at most its
+//! excursion `e_j = max |q_j(s') − q_j(m)|` over `s'` in `[a, b]`, found exactly from the
+//! polynomial (its extremes lie at the ends or at roots of its derivative). Any configuration
+//! of the stretch is then reachable from the one at `m` by a straight joint-space move of at
+//! most `e_j` per joint, so every point of link `k` lies within `Σ_j e_j · r_jk` of where it is at
+//! `m` (the lever bounds of `joint_motion`, tightened the same way with the configuration at
+//! `m`). With a path tolerance `τ_j` (a controller may stray that far from the path) the
+//! excursion is `e_j + τ_j`: the link at `m` grown by the bound holds the whole tube, and a
+//! stretch whose bound is within the ladder's first rung of the tolerance's own share cannot be
+//! narrowed (`MotionPath::floor`).
+
+use super::checker::Checker;
+use super::motion_sweep::{MotionPath, MotionReport};
+use super::spline_poly::SegmentPoly;
+use super::state_report::StateReport;
+use crate::math::{pose_from_isometry, Pose, Real, Vector};
+use crate::model::JointKind;
+
+/// One segment of an executed trajectory, in joint space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SplineSegment {
+    /// Per joint of the robot (indexed like its `joints`): the position over the segment. Only
+    /// actuated joints' are read; mimic joints follow their master.
+    pub joints: Vec<SegmentPoly>,
+    /// Per joint: how far the executed path may stray from these polynomials (radians or
+    /// metres); empty for none.
+    pub tolerance: Vec<f64>,
+}
+
+impl SplineSegment {
+    /// Positions of every joint at `s` (mimics from their master, as forward kinematics has them).
+    pub fn at(&self, s: f64) -> Vec<f64> {
+        self.joints.iter().map(|p| p.at(s)).collect()
+    }
+}
+
+/// A segment as the adaptive loop sees it.
+struct SplinePath<'a> {
+    checker: &'a Checker,
+    segment: &'a SplineSegment,
+    /// Per joint (mimics resolved): the polynomial, its turning points, its tolerance.
+    polys: Vec<SegmentPoly>,
+    turning: Vec<Vec<f64>>,
+    tolerance: Vec<f64>,
+    /// Per target: `Σ_j (top speed_j + τ_j) r_jk`, positive whenever the target can move.
+    speeds: Vec<Real>,
+    /// Per target: `Σ_j τ_j r_jk`.
+    floors: Vec<Real>,
+    /// Per target: the levers of `MotionBounds`, each revolute joint's grown by how far a
+    /// prismatic joint below it strays past its limits on this segment (the levers assume the
+    /// limits; a spline can overshoot them).
+    levers: Vec<Vec<(usize, Real)>>,
+}
+
+impl SplinePath<'_> {
+    /// Per joint: the excursion over `[mid - half, mid + half]` (within `[0, 1]`), grown by its
+    /// tolerance, with a margin for the rounding of the polynomial's evaluation.
+    fn excursions(&self, mid: f64, half: f64) -> Vec<f64> {
+        let (a, b) = ((mid - half).max(0.0), (mid + half).min(1.0));
+        self.polys
+            .iter()
+            .zip(&self.turning)
+            .zip(&self.tolerance)
+            .map(|((p, t), tol)| {
+                let e = p.excursion(t, mid, a, b);
+                e + tol + 1e-12 * (1.0 + p.at(mid).abs())
+            })
+            .collect()
+    }
+
+    /// Per joint that moves target `ti` and not target `other`, the sum of excursion times lever.
+    fn own(&self, x: usize, y: usize, e: &[f64]) -> Real {
+        let levers = &self.levers;
+        levers[x].iter().filter(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).map(|(j, r)| e[*j] * r).sum()
+    }
+
+    fn bound_with(&self, ti: usize, poses: &[Option<Pose>], e: &[f64]) -> Real {
+        let robot = self.checker.robot();
+        let bounds = self.checker.motion_bounds();
+        let plain: Real = self.levers[ti].iter().map(|(j, r)| e[*j] * r).sum();
+        let Some(link) = poses[self.checker.targets()[ti].link] else { return plain };
+        let reach = bounds.reach[ti];
+        // As in `JointPath::bound`: a joint's lever is at most the distance from its axis to the
+        // link's origin at the middle plus the link's reach, plus what the joints between it and
+        // the link can change that distance by on the stretch.
+        let (mut below, mut total) = (0.0, 0.0);
+        for &(j, r) in &self.levers[ti] {
+            let joint = &robot.joints[j];
+            let lever = match (joint.kind, poses[joint.child]) {
+                (JointKind::Revolute | JointKind::Continuous, Some(child)) => {
+                    let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
+                    let rel = link.translation - child.translation;
+                    let off_axis = (rel - axis * rel.dot(axis)).length();
+                    r.min(off_axis + reach + below)
+                }
+                _ => r,
+            };
+            total += e[j] * lever;
+            below += e[j] * r;
+        }
+        // NaN (a bad pose) falls back to the plain lever bound.
+        if total < plain {
+            total
+        } else {
+            plain
+        }
+    }
+}
+
+impl MotionPath for SplinePath<'_> {
+    fn speeds(&self) -> &[Real] {
+        &self.speeds
+    }
+
+    fn link_poses(&self, s: f64) -> Result<Vec<Option<Pose>>, String> {
+        let poses = self.checker.robot().forward_kinematics(&self.segment.at(s), self.checker.base_pose()).map_err(|e| e.to_string())?;
+        Ok(poses.iter().map(|p| Some(pose_from_isometry(p))).collect())
+    }
+
+    fn bound(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
+        self.bound_with(ti, poses, &self.excursions(mid, half))
+    }
+
+    fn report_at(&self, s: f64) -> StateReport {
+        self.checker.check_positions(&self.segment.at(s)).unwrap_or_else(|e| StateReport::failed(e.to_string()))
+    }
+
+    fn floor(&self, ti: usize) -> Real {
+        self.floors[ti]
+    }
+
+    /// The relative bounds of `JointPath::pair_bound` when there is no tolerance (the joints
+    /// above both links move the pair as one body); with one, the world bounds, whose floor
+    /// [`MotionPath::floor`] gives.
+    fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> (Real, Real) {
+        let e = self.excursions(mid, half);
+        let world = (self.bound_with(a, poses, &e), self.bound_with(b, poses, &e));
+        if self.floors[a] > 0.0 || self.floors[b] > 0.0 {
+            return world;
+        }
+        let relative = (self.own(a, b, &e), self.own(b, a, &e));
+        if relative.0 + relative.1 <= world.0 + world.1 {
+            relative
+        } else {
+            world
+        }
+    }
+}
+
+impl Checker {
+    /// Checks one executed trajectory segment (see the module documentation): the first
+    /// fraction of `s` not cleared, the contacts there, or free.
+    pub fn check_spline(&self, segment: &SplineSegment) -> MotionReport {
+        match self.spline_path(segment) {
+            Ok(path) => self.sweep_motion(&path),
+            Err(e) => MotionReport { report: StateReport { motion: true, ..StateReport::failed(e) }, ..Default::default() },
+        }
+    }
+
+    fn spline_path<'a>(&'a self, segment: &'a SplineSegment) -> Result<SplinePath<'a>, String> {
+        let robot = self.robot();
+        let n = robot.joints.len();
+        if segment.joints.len() != n {
+            return Err(format!("the segment gives {} joints; the robot has {n}", segment.joints.len()));
+        }
+        if !segment.tolerance.is_empty() && segment.tolerance.len() != n {
+            return Err(format!("the segment gives {} tolerances; the robot has {n} joints", segment.tolerance.len()));
+        }
+        if let Some((j, _)) = segment.joints.iter().enumerate().find(|(_, p)| p.c.iter().any(|c| !c.is_finite())) {
+            return Err(format!("joint '{}': the segment's polynomial is not finite", robot.joints[j].name));
+        }
+        let moves = |j: usize| matches!(robot.joints[j].kind, JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic);
+        let mut polys: Vec<SegmentPoly> = (0..n).map(|j| if moves(j) { segment.joints[j] } else { SegmentPoly::constant(0.0) }).collect();
+        let mut tolerance: Vec<f64> = (0..n).map(|j| if moves(j) { segment.tolerance.get(j).copied().unwrap_or(0.0) } else { 0.0 }).collect();
+        if let Some(t) = tolerance.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
+            return Err(format!("a path tolerance of {t} (allowed: finite, at least 0)"));
+        }
+        for (i, j) in robot.joints.iter().enumerate() {
+            if let Some(m) = j.mimic {
+                polys[i] = polys[m.joint].scaled(m.multiplier, m.offset);
+                tolerance[i] = m.multiplier.abs() * tolerance[m.joint];
+            }
+        }
+        let turning: Vec<Vec<f64>> = polys.iter().map(SegmentPoly::turning_points).collect();
+        let top: Vec<f64> = polys.iter().map(SegmentPoly::top_speed).collect();
+        // How far each prismatic joint strays past the larger magnitude of its limits.
+        let overshoot: Vec<f64> = (0..n)
+            .map(|j| {
+                let joint = &robot.joints[j];
+                if joint.kind != JointKind::Prismatic {
+                    return 0.0;
+                }
+                let (lo, hi) = polys[j].range(&turning[j]);
+                let reach = lo.abs().max(hi.abs()) + tolerance[j];
+                (reach - joint.limits[0].abs().max(joint.limits[1].abs())).max(0.0)
+            })
+            .collect();
+        let levers: Vec<Vec<(usize, Real)>> = self
+            .motion_bounds()
+            .levers
+            .iter()
+            .map(|list| {
+                // Nearest first: a prismatic joint lengthens the levers of the joints above it.
+                let mut extra = 0.0;
+                list.iter()
+                    .map(|&(j, r)| {
+                        let r = if robot.joints[j].kind == JointKind::Prismatic { r } else { r + extra };
+                        extra += overshoot[j];
+                        (j, r)
+                    })
+                    .collect()
+            })
+            .collect();
+        let speeds = levers.iter().map(|l| l.iter().map(|(j, r)| (top[*j] + tolerance[*j]) * r).sum()).collect();
+        let floors = levers.iter().map(|l| l.iter().map(|(j, r)| tolerance[*j] * r).sum()).collect();
+        Ok(SplinePath { checker: self, segment, polys, turning, tolerance, speeds, floors, levers })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::checker::test_points::part_points;
+    use crate::model::Params;
+
+    /// The bound the adaptive loop trusts, checked directly: over random quintic, cubic and linear
+    /// segments of the bundled arm (revolute, continuous, prismatic and mimic joints), with and
+    /// without a tolerance, no point of any link, sampled along a stretch (and, with a tolerance,
+    /// at random configurations of the tube around it), lies farther from where it is at the
+    /// stretch's middle than the bound.
+    #[test]
+    fn no_point_of_a_link_leaves_its_bound_on_a_spline() {
+        let c = Checker::from_params(Params::default()).unwrap();
+        let robot = c.robot();
+        let mut rng = oorandom::Rand64::new(34);
+        let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
+        let (mut checked, mut tightest) = (0usize, 0.0f64);
+        for case in 0..300 {
+            let duration = draw(0.2, 2.0);
+            let joints: Vec<SegmentPoly> = robot
+                .joints
+                .iter()
+                .map(|j| {
+                    let [lo, hi] = j.limits;
+                    let (lo, hi) = if lo.is_finite() && hi.is_finite() { (lo, hi) } else { (-3.0, 3.0) };
+                    let (p0, mut p1) = (draw(lo, hi), draw(lo, hi));
+                    let (mut v0, mut v1, a0, a1) = (draw(-2.0, 2.0), draw(-2.0, 2.0), draw(-8.0, 8.0), draw(-8.0, 8.0));
+                    if case % 5 == 0 {
+                        // Out and back: the extreme is inside the segment, away from its ends.
+                        (p1, v0, v1) = (p0, 2.0 * duration, -2.0 * duration);
+                    }
+                    match case % 3 {
+                        0 => SegmentPoly::quintic(p0, v0, a0, p1, v1, a1, duration),
+                        1 => SegmentPoly::cubic(p0, v0, p1, v1, duration),
+                        _ => SegmentPoly::linear(p0, p1),
+                    }
+                })
+                .collect();
+            let tolerance = if case % 2 == 0 { Vec::new() } else { robot.joints.iter().map(|_| draw(0.0, 0.05)).collect() };
+            let segment = SplineSegment { joints, tolerance: tolerance.clone() };
+            let path = c.spline_path(&segment).unwrap();
+            let half = [0.5, 0.2, 0.05, 0.01][checked % 4];
+            let s = draw(0.0, 1.0);
+            let poses = path.link_poses(s).unwrap();
+            for (ti, t) in c.targets().iter().enumerate() {
+                let bound = path.bound(ti, &poses, s, half);
+                let points: Vec<Vector> = t.parts.iter().flat_map(|(shape, offset)| part_points(shape, offset)).collect();
+                let at = poses[t.link].unwrap();
+                let mut farthest = 0.0f64;
+                for k in 0..=24 {
+                    let other = (s - half + 2.0 * half * k as f64 / 24.0).clamp(0.0, 1.0);
+                    let mut q = segment.at(other);
+                    if !tolerance.is_empty() {
+                        q.iter_mut().zip(&tolerance).for_each(|(x, t)| *x += t * [-1.0, 1.0, 0.3, -0.7][k % 4]);
+                    }
+                    let pose = pose_from_isometry(&robot.forward_kinematics(&q, c.base_pose()).unwrap()[t.link]);
+                    for p in &points {
+                        farthest = farthest.max(((pose * *p) - (at * *p)).length());
+                    }
+                }
+                assert!(farthest <= bound + 1e-9, "case {case}: link '{}' moved {farthest} m within {half} of s = {s}, bound {bound}", t.name);
+                if bound > 0.0 {
+                    tightest = tightest.max(farthest / bound);
+                }
+            }
+            checked += 1;
+        }
+        assert!(tightest > 0.3, "largest motion / bound {tightest}");
+        eprintln!("{checked} stretches, largest motion / bound {tightest:.3}");
+    }
+}

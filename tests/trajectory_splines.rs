@@ -1,0 +1,266 @@
+//! Issue 34: trajectories checked as `joint_trajectory_controller` executes them, against an
+//! oracle of this test's own: the controller's spline rules written out here in seconds (from
+//! ros2_controllers' `trajectory.cpp`: quintic with velocities and accelerations, cubic with
+//! velocities, linear otherwise; the approach from the current state, a continuous joint the
+//! shorter way), sampled so densely that no point of the arm moves 1 mm between samples (the
+//! 1.2 m reach bound of `tests/motion_properties.rs` times a bound on each joint's speed from its
+//! polynomial's coefficients), each sample checked by the discrete checker (proven against
+//! parry's GJK in `tests/sat_oracle.rs`); a near miss measured with parry's GJK distance.
+//!
+//! The Panda (example-robot-data) among the bundled workcell's thin surfaces, random
+//! time-parameterised trajectories with velocities and accelerations, starting from a joint state
+//! with velocities. For every trajectory:
+//! - one with a colliding sample is never reported valid;
+//! - the reported time is never later than the first colliding sample's;
+//! - a trajectory reported colliding has a sample within `motion_tolerance` plus one step of the
+//!   object it names.
+//!
+//! And some trajectories whose waypoints and straight chords are all free (the linear check says
+//! valid) have colliding samples on the executed spline: the spline check catches every one.
+
+mod common;
+
+use oorandom::Rand64;
+use thickness_collision::checker::Checker;
+use thickness_collision::model::{InputFiles, Params};
+use thickness_collision::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, DurationMsg, JointState, JointTrajectory, JointTrajectoryPoint};
+use thickness_collision::pipeline::Pipeline;
+
+const REACH: f64 = 1.2;
+const STEP: f64 = 1e-3;
+const TRAJECTORIES: usize = 150;
+
+fn panda_params() -> Params {
+    let erd = common::example_robot_data();
+    Params {
+        package_map: vec![format!("example-robot-data={}", erd.display())],
+        robot_base_pose: vec![0.0, 0.0, 0.005, 0.0, 0.0, 0.0],
+        input_files: InputFiles { robot: Some(erd.join("robots/panda_description/urdf/panda.urdf")), environment: None },
+        ..Params::default()
+    }
+}
+
+/// One end of a segment: positions, velocities and accelerations (per second; empty: not given).
+#[derive(Clone, Debug)]
+struct End {
+    p: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+}
+
+/// The oracle's segment: the controller's coefficients in seconds, per joint, and its duration.
+struct Segment {
+    coefficients: Vec<[f64; 6]>,
+    duration: f64,
+}
+
+impl Segment {
+    /// `interpolate_between_points`, its three branches.
+    fn between(from: &End, to: &End, duration: f64) -> Segment {
+        let t = duration;
+        let coefficients = (0..from.p.len())
+            .map(|i| {
+                let (p0, p1) = (from.p[i], to.p[i]);
+                if !from.v.is_empty() && !to.v.is_empty() && !from.a.is_empty() && !to.a.is_empty() {
+                    let (v0, v1, a0, a1) = (from.v[i], to.v[i], from.a[i], to.a[i]);
+                    [
+                        p0,
+                        v0,
+                        0.5 * a0,
+                        (-20.0 * p0 + 20.0 * p1 - 3.0 * a0 * t * t + a1 * t * t - 12.0 * v0 * t - 8.0 * v1 * t) / (2.0 * t.powi(3)),
+                        (30.0 * p0 - 30.0 * p1 + 3.0 * a0 * t * t - 2.0 * a1 * t * t + 16.0 * v0 * t + 14.0 * v1 * t) / (2.0 * t.powi(4)),
+                        (-12.0 * p0 + 12.0 * p1 - a0 * t * t + a1 * t * t - 6.0 * v0 * t - 6.0 * v1 * t) / (2.0 * t.powi(5)),
+                    ]
+                } else if !from.v.is_empty() && !to.v.is_empty() {
+                    let (v0, v1) = (from.v[i], to.v[i]);
+                    [p0, v0, (-3.0 * p0 + 3.0 * p1 - 2.0 * v0 * t - v1 * t) / (t * t), (2.0 * p0 - 2.0 * p1 + v0 * t + v1 * t) / t.powi(3), 0.0, 0.0]
+                } else {
+                    [p0, (p1 - p0) / t, 0.0, 0.0, 0.0, 0.0]
+                }
+            })
+            .collect();
+        Segment { coefficients, duration }
+    }
+
+    fn at(&self, t: f64) -> Vec<f64> {
+        self.coefficients.iter().map(|c| (0..6).map(|k| c[k] * t.powi(k as i32)).sum()).collect()
+    }
+
+    /// Samples so that no point of the arm moves more than `STEP` between two: each joint's speed
+    /// on the segment is at most the largest of 1,000 evenly spaced samples of it plus its
+    /// acceleration bound `Σ k (k-1) |c_k| T^(k-2)` times half their spacing.
+    fn samples(&self) -> usize {
+        let t = self.duration;
+        let h = t / 1000.0;
+        let travel: f64 = self
+            .coefficients
+            .iter()
+            .map(|c| {
+                let speed = |x: f64| (1..6).map(|k| k as f64 * c[k] * x.powi(k as i32 - 1)).sum::<f64>().abs();
+                let sampled = (0..=1000).map(|i| speed(i as f64 * h)).fold(0.0, f64::max);
+                let acceleration: f64 = (2..6).map(|k| (k * (k - 1)) as f64 * c[k].abs() * t.powi(k as i32 - 2)).sum();
+                (sampled + acceleration * h / 2.0) * t
+            })
+            .sum();
+        ((REACH * travel / STEP).ceil() as usize).max(1)
+    }
+}
+
+/// The whole trajectory as the oracle executes it: the approach (when the first point comes
+/// after 0), then the segments; each with its start time.
+fn executed(start: &End, points: &[(End, f64)], continuous: &[bool]) -> Vec<(Segment, f64)> {
+    let mut out = Vec::new();
+    let (first, t0) = &points[0];
+    if *t0 > 0.0 {
+        let mut from = start.clone();
+        for (i, c) in continuous.iter().enumerate() {
+            if *c {
+                let d = (first.p[i] - from.p[i]).rem_euclid(std::f64::consts::TAU);
+                let d = if d > std::f64::consts::PI { d - std::f64::consts::TAU } else { d };
+                from.p[i] = first.p[i] - d;
+            }
+        }
+        from.v = if first.v.is_empty() { Vec::new() } else { start.v.clone() };
+        from.a = if first.a.is_empty() { Vec::new() } else { vec![0.0; start.p.len()] };
+        out.push((Segment::between(&from, first, *t0), 0.0));
+    }
+    for w in points.windows(2) {
+        out.push((Segment::between(&w[0].0, &w[1].0, w[1].1 - w[0].1), w[0].1));
+    }
+    out
+}
+
+/// The first colliding sample's time, and the configurations sampled just after `time` (for a
+/// near miss), over the executed trajectory.
+fn oracle(c: &Checker, full: &dyn Fn(&[f64]) -> Vec<f64>, segments: &[(Segment, f64)], time: Option<f64>) -> (Option<f64>, Vec<Vec<f64>>, usize) {
+    let (mut first, mut near, mut count) = (None, Vec::new(), 0);
+    for (segment, t0) in segments {
+        let n = segment.samples();
+        count += n + 1;
+        for k in 0..=n {
+            let t = segment.duration * k as f64 / n as f64;
+            let q = full(&segment.at(t));
+            if let Some(reported) = time {
+                if t0 + t >= reported - segment.duration / n as f64 && near.len() < 4 {
+                    near.push(q.clone());
+                }
+            }
+            if first.is_none() && c.check_positions(&q).unwrap().in_collision {
+                first = Some(t0 + t);
+            }
+            if first.is_some() && (time.is_none() || near.len() >= 4) {
+                return (first, near, count);
+            }
+        }
+    }
+    (first, near, count)
+}
+
+fn seconds(d: &DurationMsg) -> f64 {
+    d.sec as f64 + d.nanosec as f64 * 1e-9
+}
+
+fn request(names: &[String], points: &[(End, f64)], interpolation: &str) -> CheckTrajectoryRequest {
+    let points = points
+        .iter()
+        .map(|(e, t)| JointTrajectoryPoint {
+            positions: e.p.clone(),
+            velocities: e.v.clone(),
+            accelerations: e.a.clone(),
+            time_from_start: DurationMsg { sec: t.floor() as i32, nanosec: ((t - t.floor()) * 1e9).round() as u32 },
+            ..Default::default()
+        })
+        .collect();
+    CheckTrajectoryRequest {
+        trajectory: JointTrajectory { joint_names: names.to_vec(), points, ..Default::default() },
+        interpolation: interpolation.into(),
+        path_tolerance: Vec::new(),
+    }
+}
+
+#[test]
+fn executed_trajectories_agree_with_dense_sampling() {
+    let mut pipeline = Pipeline::new(panda_params()).unwrap();
+    let c = pipeline.checker().clone();
+    let robot = c.robot();
+    let names: Vec<String> = (1..=7).map(|i| format!("panda_joint{i}")).collect();
+    let arm: Vec<usize> = names.iter().map(|n| robot.joint(n).unwrap()).collect();
+    let fingers: Vec<String> = robot.joints.iter().filter(|j| j.is_actuated() && !names.contains(&j.name)).map(|j| j.name.clone()).collect();
+    let continuous: Vec<bool> = arm.iter().map(|&j| robot.joints[j].kind == thickness_collision::model::JointKind::Continuous).collect();
+    let mut rng = Rand64::new(34);
+    let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
+    let (mut colliding, mut free, mut near_misses, mut bulges, mut samples) = (0, 0, 0, 0, 0usize);
+    for m in 0..TRAJECTORIES {
+        // A start state (with velocities), then 3 or 4 points 0.4-1.2 s apart, each joint moving
+        // up to 0.5 rad a segment, with velocities and (mostly) accelerations.
+        let limits: Vec<[f64; 2]> = arm.iter().map(|&j| robot.joints[j].limits).collect();
+        let centre: Vec<f64> = limits.iter().map(|[lo, hi]| draw(lo + 0.3 * (hi - lo), hi - 0.3 * (hi - lo))).collect();
+        let start = End { p: centre.clone(), v: (0..7).map(|_| draw(-0.3, 0.3)).collect(), a: Vec::new() };
+        let with_accelerations = m % 4 != 0;
+        let mut t = draw(0.0, 1.0).max(0.0);
+        if m % 3 == 0 {
+            t = 0.0;
+        }
+        let mut points = Vec::new();
+        let mut p = centre.clone();
+        for _ in 0..(3 + m % 2) {
+            p = p.iter().zip(&limits).map(|(x, [lo, hi])| (x + draw(-0.35, 0.35)).clamp(*lo, *hi)).collect();
+            let v: Vec<f64> = (0..7).map(|_| draw(-0.8, 0.8)).collect();
+            let a: Vec<f64> = if with_accelerations { (0..7).map(|_| draw(-4.0, 4.0)).collect() } else { Vec::new() };
+            points.push((End { p: p.clone(), v, a }, t));
+            t += draw(0.4, 1.2);
+        }
+        // The node's current state: the start (fingers closed).
+        let mut state_names = names.clone();
+        state_names.extend(fingers.iter().cloned());
+        let mut position = start.p.clone();
+        position.extend(fingers.iter().map(|_| 0.0));
+        let mut velocity = start.v.clone();
+        velocity.extend(fingers.iter().map(|_| 0.0));
+        pipeline.joint_state(&JointState { name: state_names.clone(), position: position.clone(), velocity, ..Default::default() }).unwrap();
+        let full = |arm_q: &[f64]| -> Vec<f64> {
+            let mut q = vec![0.0; robot.joints.len()];
+            arm.iter().zip(arm_q).for_each(|(&j, &x)| q[j] = x);
+            q
+        };
+
+        let r: CheckTrajectoryResponse = pipeline.check_trajectory(&request(&names, &points, ""));
+        assert!(r.error.is_empty(), "trajectory {m}: {}", r.error);
+        let reported = (!r.valid).then(|| seconds(&r.time_from_start));
+        let segments = executed(&start, &points, &continuous);
+        let (first_hit, near, count) = oracle(&c, &full, &segments, reported);
+        samples += count;
+        if let Some(s) = first_hit {
+            assert!(!r.valid, "trajectory {m}: reported valid, but the sample at t = {s} s collides");
+            let f = reported.unwrap();
+            assert!(s >= f - 1e-6, "trajectory {m}: a colliding sample at {s} s, before the reported {f} s (segment {})", r.segment);
+            // Waypoints and chords all free, the executed spline not: what the linear check misses.
+            // (Between waypoints: the linear check has no approach.)
+            if r.segment >= 0 && pipeline.check_trajectory(&request(&names, &points, "linear")).valid {
+                bulges += 1;
+            }
+        }
+        if r.valid {
+            free += 1;
+            continue;
+        }
+        colliding += 1;
+        let f = reported.unwrap();
+        if first_hit.is_some_and(|s| s <= f + 0.01) {
+            continue;
+        }
+        near_misses += 1;
+        let contact = r.contacts.first().unwrap_or_else(|| panic!("trajectory {m}: colliding without a contact"));
+        let nearest = common::near_miss::nearest_to_contact(&c, &contact.link_name, &contact.object_name, contact.triangle, &near);
+        let tol = c.params().motion_tolerance;
+        assert!(
+            nearest <= tol + STEP,
+            "trajectory {m}: reported colliding at {f} s, but {} stays {nearest} m from {} (tolerance {tol})",
+            contact.link_name,
+            contact.object_name
+        );
+    }
+    eprintln!("{TRAJECTORIES} Panda trajectories, {samples} oracle samples: {colliding} colliding ({near_misses} near misses, {bulges} missed by the linear check), {free} free");
+    assert!(colliding > TRAJECTORIES / 10 && free > TRAJECTORIES / 10, "the sample must have both outcomes");
+    assert!(bulges >= 3, "some executed splines must cross what their chords miss: {bulges}");
+}
