@@ -308,8 +308,11 @@ fn a_long_trajectory_is_checked_while_the_live_stream_goes_on() {
     assert!(long["max_latency"].as_f64().unwrap() < 1.0, "the live stream stalled: {long}");
 }
 
+/// A trajectory point: positions, velocities, accelerations, time from start (ns).
+type Point = (Vec<f64>, Vec<f64>, Vec<f64>, i64);
+
 /// A trajectory of the bundled arm for `check --trajectory` (its JSON file) and for the peer.
-fn executed_request(names: &[String], points: &[(Vec<f64>, Vec<f64>, Vec<f64>, i64)]) -> (Value, Value) {
+fn executed_request(names: &[String], points: &[Point]) -> (Value, Value) {
     let file = json!({
         "joint_names": names,
         "points": points.iter().map(|(p, v, a, t)| json!({"positions": p, "velocities": v, "accelerations": a,
@@ -336,7 +339,7 @@ fn executed_trajectories_over_dds_equal_check_trajectory() {
     for k in 0..10 {
         let mut p = start.clone();
         let mut t = if k % 3 == 0 { 0 } else { 400_000_000 + 100_000_000 * k as i64 };
-        let points: Vec<(Vec<f64>, Vec<f64>, Vec<f64>, i64)> = (0..3)
+        let points: Vec<Point> = (0..3)
             .map(|_| {
                 p = arm.random(&mut rng, Some(&p), 0.5);
                 let v: Vec<f64> = p.iter().map(|_| 1.6 * rng.rand_float() - 0.8).collect();
