@@ -22,6 +22,7 @@ mod common;
 
 use oorandom::Rand64;
 use thickness_collision::checker::Checker;
+use thickness_collision::collision::TargetShape;
 use thickness_collision::model::{InputFiles, Params};
 use thickness_collision::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, DurationMsg, JointState, JointTrajectory, JointTrajectoryPoint};
 use thickness_collision::pipeline::Pipeline;
@@ -263,4 +264,154 @@ fn executed_trajectories_agree_with_dense_sampling() {
     eprintln!("{TRAJECTORIES} Panda trajectories, {samples} oracle samples: {colliding} colliding ({near_misses} near misses, {bulges} missed by the linear check), {free} free");
     assert!(colliding > TRAJECTORIES / 10 && free > TRAJECTORIES / 10, "the sample must have both outcomes");
     assert!(bulges >= 3, "some executed splines must cross what their chords miss: {bulges}");
+}
+
+/// The farthest any point of a link that joint `j` moves can be from `j`'s axis, in any
+/// configuration: the joint origins' distances along the chain below it plus the link's reach
+/// (the lever bound of the motion check, recomputed here from the model).
+fn lever_bound(c: &Checker, j: usize) -> f64 {
+    let robot = c.robot();
+    let mut farthest = 0.0f64;
+    for t in c.targets() {
+        let own = |shape: &TargetShape| match shape {
+            TargetShape::Polytope(h) => h.points().iter().map(|p| p.length()).fold(0.0, f64::max),
+            TargetShape::Sphere { radius } => *radius,
+            TargetShape::Capsule { half_height, radius } => half_height + radius,
+            TargetShape::Cylinder { half_height, radius } => half_height.hypot(*radius),
+        };
+        let reach = t.parts.iter().map(|(shape, offset)| offset.translation.length() + own(shape)).fold(0.0, f64::max);
+        let (mut chain, mut link, mut moved) = (reach, t.link, false);
+        while let Some(k) = robot.joints.iter().position(|x| x.child == link) {
+            if k == j {
+                moved = true;
+                break;
+            }
+            chain += robot.joints[k].origin.translation.vector.norm();
+            if robot.joints[k].kind == thickness_collision::model::JointKind::Prismatic {
+                chain += robot.joints[k].limits[0].abs().max(robot.joints[k].limits[1].abs());
+            }
+            link = robot.joints[k].parent;
+        }
+        if moved {
+            farthest = farthest.max(chain);
+        }
+    }
+    farthest
+}
+
+/// The tube (issue 34, part 3): the bundled arm held 2 cm from the guard sheet (its clearance,
+/// found by bisection). Tolerances on every arm joint that together move no point more than 1 cm
+/// (by the lever bound) are accepted; a tolerance on one joint that moves the link nearest the
+/// sheet 3 cm (and whose tube really reaches the sheet: a configuration within it collides) is
+/// refused.
+#[test]
+fn a_tube_is_refused_only_when_it_can_reach_a_sheet() {
+    let params = Params { clearance_threshold: 0.2, ..Params::default() };
+    let mut pipeline = Pipeline::new(params).unwrap();
+    let c = pipeline.checker().clone();
+    let robot = c.robot();
+    let names: Vec<String> = robot.joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
+    let index: Vec<usize> = names.iter().map(|n| robot.joint(n).unwrap()).collect();
+    let full = |named: &[f64]| -> Vec<f64> {
+        let mut q = vec![0.0; robot.joints.len()];
+        index.iter().zip(named).for_each(|(&j, &x)| q[j] = x);
+        q
+    };
+    let clearance = |named: &[f64]| -> (f64, String) {
+        let r = c.check_positions(&full(named)).unwrap();
+        if r.in_collision {
+            return (0.0, String::new());
+        }
+        // To the guard sheet (the base stands on the table).
+        r.clearances
+            .iter()
+            .filter(|x| x.object_name == "guard_sheet")
+            .map(|x| (x.distance, x.link_name.clone()))
+            .fold((f64::INFINITY, String::new()), |a, b| if b.0 < a.0 { b } else { a })
+    };
+    // From a free pose towards one inside the guard (as in the motion check's own test).
+    let slot = |n: &str| names.iter().position(|x| x == n).unwrap();
+    let free = vec![0.0; names.len()];
+    let mut into = free.clone();
+    (into[slot("shoulder_lift_joint")], into[slot("elbow_joint")]) = (1.2, 0.3);
+    let at = |s: f64| -> Vec<f64> { free.iter().zip(&into).map(|(a, b)| a + s * (b - a)).collect() };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    assert!(
+        clearance(&at(lo)).0 > 0.02 && clearance(&at(hi)).0 == 0.0,
+        "{:?} {:?} {:?}",
+        clearance(&at(lo)),
+        clearance(&at(hi)),
+        c.check_positions(&full(&at(lo))).unwrap()
+    );
+    for _ in 0..60 {
+        let m = 0.5 * (lo + hi);
+        if clearance(&at(m)).0 > 0.02 {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    let pose = at(lo);
+    let (gap, nearest) = clearance(&pose);
+    assert!((gap - 0.02).abs() < 1e-4, "{gap}");
+    pipeline.joint_state(&JointState { name: names.clone(), position: pose.clone(), ..Default::default() }).unwrap();
+    let still = |tolerance: Vec<f64>| CheckTrajectoryRequest {
+        trajectory: JointTrajectory {
+            joint_names: names.clone(),
+            points: [0, 1]
+                .iter()
+                .map(|&s| JointTrajectoryPoint { positions: pose.clone(), time_from_start: DurationMsg { sec: s, nanosec: 0 }, ..Default::default() })
+                .collect(),
+            ..Default::default()
+        },
+        path_tolerance: tolerance,
+        ..Default::default()
+    };
+    assert!(pipeline.check_trajectory(&still(Vec::new())).valid, "2 cm from the sheet, held still: free");
+    // 1 cm in all, shared evenly among the joints by their lever bounds.
+    let small: Vec<f64> = index.iter().map(|&j| 0.01 / names.len() as f64 / lever_bound(&c, j)).collect();
+    let r = pipeline.check_trajectory(&still(small.clone()));
+    assert!(r.valid && r.error.is_empty(), "a tube moving no point more than 1 cm must be free: {r:?}");
+    // One joint at a time, a tolerance that moves the nearest point of the nearest link 3 cm
+    // (its distance from the joint's axis): refused when that tube reaches the sheet (some
+    // configuration within it collides).
+    let report = c.check_positions(&full(&pose)).unwrap();
+    let near = report.clearances.iter().find(|x| x.link_name == nearest && x.object_name == "guard_sheet").unwrap();
+    let point = nalgebra::Vector3::from(near.point_on_link);
+    let poses = robot.forward_kinematics(&full(&pose), c.base_pose()).unwrap();
+    let link = c.targets().iter().find(|t| t.name == nearest).unwrap().link;
+    let mut refused = 0;
+    for (k, &j) in index.iter().enumerate() {
+        let joint = &robot.joints[j];
+        let mut above = link;
+        let moves = std::iter::from_fn(|| {
+            let parent = robot.joints.iter().position(|x| x.child == above)?;
+            above = robot.joints[parent].parent;
+            Some(parent)
+        })
+        .any(|p| p == j);
+        if !moves || joint.kind != thickness_collision::model::JointKind::Revolute {
+            continue;
+        }
+        let frame = poses[joint.child];
+        let axis = frame.rotation * joint.axis.into_inner();
+        let rel = point - frame.translation.vector;
+        let lever = (rel - axis * rel.dot(&axis)).norm();
+        let tau = 0.03 / lever;
+        let reaches = (0..=40).any(|i| {
+            let mut q = pose.clone();
+            q[k] += tau * (i as f64 / 20.0 - 1.0);
+            c.check_positions(&full(&q)).unwrap().in_collision
+        });
+        eprintln!("joint {}: lever {lever:.3} m, tolerance {tau:.4} rad, the tube reaches the sheet: {reaches}", names[k]);
+        if !reaches {
+            continue;
+        }
+        let mut tolerance = vec![0.0; names.len()];
+        tolerance[k] = tau;
+        let r = pipeline.check_trajectory(&still(tolerance));
+        assert!(!r.valid && r.error.is_empty() && !r.contacts.is_empty(), "joint {}: a tube that reaches the sheet must be refused: {r:?}", names[k]);
+        refused += 1;
+    }
+    assert!(refused > 0, "some joint's 3 cm tube must reach the sheet");
 }
