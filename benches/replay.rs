@@ -58,6 +58,7 @@ fn main() {
             motion: Some(false),
             plot: None,
             no_markers: true,
+            trajectory_topic: None,
         };
         let started = Instant::now();
         let summary = replay(Params::default(), &opts, &mut Quiet).unwrap();

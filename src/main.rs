@@ -134,6 +134,13 @@ enum Command {
         /// Check every state on its own, not the motions between them.
         #[arg(long, overrides_with = "motion")]
         no_motion: bool,
+        /// A `trajectory_msgs/JointTrajectory` topic (e.g.
+        /// `/joint_trajectory_controller/joint_trajectory`): each trajectory checked as the
+        /// controller executes it, from the joint state recorded before it, until the next one
+        /// preempts it; one JSON line per trajectory in `--jsonl` (as `check --trajectory
+        /// --json`, with `trajectory`, `log_time` and `preempted_after`).
+        #[arg(long)]
+        trajectory_topic: Option<String>,
     },
 }
 
@@ -182,7 +189,7 @@ fn run(cli: Cli) -> Result<()> {
         },
         #[cfg(feature = "ros")]
         Command::Run { model, ros_args } => cli::run::run(&model, &ros_args),
-        Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, no_markers, plot, jsonl, start, end, motion, no_motion } => {
+        Command::Replay { bag, model, topic, pose_source, frame_prefix, out_dir, no_markers, plot, jsonl, start, end, motion, no_motion, trajectory_topic } => {
             let motion = if motion {
                 Some(true)
             } else if no_motion {
@@ -190,8 +197,20 @@ fn run(cli: Cli) -> Result<()> {
             } else {
                 None
             };
-            let opts =
-                thickness_collision::replay::ReplayOptions { bag, topic, pose_source, frame_prefix, out_dir, jsonl, start, end, motion, plot, no_markers };
+            let opts = thickness_collision::replay::ReplayOptions {
+                bag,
+                topic,
+                pose_source,
+                frame_prefix,
+                out_dir,
+                jsonl,
+                start,
+                end,
+                motion,
+                plot,
+                no_markers,
+                trajectory_topic,
+            };
             cli::replay::replay(&model, &opts)
         }
     }

@@ -298,3 +298,110 @@ fn bad_bags_are_clear_errors() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("/arm/joint_states") && err.contains("/joint_states"), "{err}");
 }
+
+/// A trajectory of the bundled arm from `start`: three points 0.5 s apart (the first after
+/// 0.3 s, so the approach counts too), each joint moving up to 0.4 rad, with velocities.
+fn arm_trajectory(names: &[String], start: &[f64], rng: &mut Rand64) -> Value {
+    let mut p = start.to_vec();
+    let points: Vec<Value> = (0..3)
+        .map(|k| {
+            p = p.iter().map(|x| x + 0.8 * rng.rand_float() - 0.4).collect();
+            let v: Vec<f64> = p.iter().map(|_| 1.2 * rng.rand_float() - 0.6).collect();
+            json!({"positions": p, "velocities": v, "t": 300_000_000 + 500_000_000 * k})
+        })
+        .collect();
+    json!({"joint_names": names, "points": points})
+}
+
+/// `check --trajectory --json` on `trajectory` from `start` (at rest).
+fn check_trajectory_cli(d: &Path, name: &str, names: &[String], start: &[f64], trajectory: &Value) -> Value {
+    let file = d.join(format!("{name}.json"));
+    let points: Vec<Value> = trajectory["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let t = p["t"].as_i64().unwrap();
+            json!({"positions": p["positions"], "velocities": p["velocities"], "time_from_start": {"sec": t / 1_000_000_000, "nanosec": t % 1_000_000_000}})
+        })
+        .collect();
+    std::fs::write(&file, json!({"joint_names": names, "points": points}).to_string()).unwrap();
+    let joints: Vec<String> = names.iter().zip(start).map(|(n, x)| format!("{n}={x}")).collect();
+    let out = ok(bin().args(["check", "--trajectory", file.to_str().unwrap(), "--json", "--joints", &joints.join(",")]).output().unwrap());
+    serde_json::from_str(out.trim()).unwrap()
+}
+
+/// Issue 34, `replay --trajectory-topic`: trajectories recorded on a controller's topic between
+/// joint states. Each is checked from the state recorded before it; one that runs to its first
+/// contact before the next arrives answers as `check --trajectory` from that state does; one
+/// preempted before its contact is free for what was executed; the last runs to its end.
+#[test]
+fn recorded_trajectories_replay_as_check_trajectory_answers() {
+    let d = dir("trajectories");
+    let (names, pool) = common::random_arm_states(400, 34);
+    let params = Params::default();
+    let mut pipeline = thickness_collision::pipeline::Pipeline::new(params).unwrap();
+    let mut rng = Rand64::new(34);
+    // Search: free starts, and trajectories from them that collide (with the contact's time).
+    let mut colliding = Vec::new();
+    for s in &pool {
+        if colliding.len() == 3 {
+            break;
+        }
+        let state = thickness_collision::msgs::JointState { name: names.clone(), position: s.clone(), ..Default::default() };
+        if pipeline.joint_state(&state).is_err() || pipeline.checker().check_joints(&names, s).unwrap().in_collision {
+            continue;
+        }
+        let t = arm_trajectory(&names, s, &mut rng);
+        let cli = check_trajectory_cli(&d, &format!("search_{}", colliding.len()), &names, s, &t);
+        if cli["in_collision"] == true && cli["error"] == "" && cli["time"].as_f64().unwrap() > 0.2 {
+            colliding.push((s.clone(), t, cli));
+        }
+    }
+    assert_eq!(colliding.len(), 3, "three colliding trajectories from free starts");
+    let [(s0, c, c_cli), (s1, a, a_cli), (s2, b, b_cli)] = <[_; 3]>::try_from(colliding).unwrap();
+    let (tc, ta) = (c_cli["time"].as_f64().unwrap(), a_cli["time"].as_f64().unwrap());
+    let ns = |s: f64| (s * 1e9) as i64;
+    // C runs past its contact; A is preempted halfway to its contact by B, which runs to its end.
+    let t_c = T0 + 100_000_000;
+    let t_a = t_c + ns(tc) + 300_000_000;
+    let t_b = t_a + ns(ta / 2.0);
+    let js = |t: i64, p: &[f64]| json!({"t": t, "stamp": t, "name": names, "position": p});
+    let messages = vec![
+        js(T0, &s0),
+        json!({"t": t_c, "trajectory": c}),
+        js(t_a - 50_000_000, &s1),
+        json!({"t": t_a, "trajectory": a}),
+        js(t_b - 10_000_000, &s2),
+        json!({"t": t_b, "trajectory": b}),
+    ];
+    let bag = d.join("in");
+    write_bag(&bag, "mcap", &messages, None);
+    let jsonl = d.join("out.jsonl");
+    let summary = ok(bin()
+        .args(["replay", bag.to_str().unwrap(), "--trajectory-topic", "/joint_trajectory_controller/joint_trajectory", "--jsonl", jsonl.to_str().unwrap()])
+        .output()
+        .unwrap());
+    assert!(summary.contains("trajectories: 3, in collision or not checked: 2"), "{summary}");
+    let lines: Vec<Value> =
+        std::fs::read_to_string(&jsonl).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).filter(|v: &Value| v.get("trajectory").is_some()).collect();
+    assert_eq!(lines.len(), 3, "one line per trajectory: {lines:?}");
+    let same = |got: &Value, want: &Value, what: &str| {
+        for key in ["in_collision", "time", "segment", "fraction", "error"] {
+            assert_eq!(got[key], want[key], "{what}: {key}: {got} vs {want}");
+        }
+        let (g, w) = (got["contacts"].as_array().unwrap(), want["contacts"].as_array().unwrap());
+        assert_eq!(g.len(), w.len(), "{what}");
+        for (x, y) in g.iter().zip(w) {
+            for key in ["link_name", "object_name", "triangle"] {
+                assert_eq!(x[key], y[key], "{what}: {key}");
+            }
+        }
+    };
+    same(&lines[0], &c_cli, "C, run past its contact");
+    assert!(lines[0]["preempted_after"].as_f64().unwrap() > tc, "{}", lines[0]);
+    assert_eq!((&lines[1]["in_collision"], &lines[1]["time"]), (&json!(false), &Value::Null), "A, preempted before its contact: {}", lines[1]);
+    assert!((lines[1]["preempted_after"].as_f64().unwrap() - ta / 2.0).abs() < 1e-6, "{}", lines[1]);
+    same(&lines[2], &b_cli, "B, run to its end");
+    assert_eq!(lines[2]["preempted_after"], Value::Null);
+}

@@ -3,11 +3,10 @@
 
 use crate::ModelArgs;
 use anyhow::{anyhow, bail, Result};
-use serde_json::json;
 use std::io::Write;
 use std::path::Path;
 use thickness_collision::msgs::{CheckTrajectoryRequest, JointState};
-use thickness_collision::pipeline::{read_trajectory_file, Interpolation, APPROACH_SEGMENT};
+use thickness_collision::pipeline::{outcome_json, read_trajectory_file, Interpolation, APPROACH_SEGMENT};
 
 /// Checks the trajectory in `file` from `--joints` (else its first point), at rest. Prints one
 /// JSON object (`--json`) or a few lines; an error when the trajectory is refused or a segment
@@ -39,29 +38,21 @@ pub fn check_trajectory(args: &ModelArgs, file: &Path, joints: Option<&str>, int
         }
     }
     let request = CheckTrajectoryRequest { trajectory, interpolation, path_tolerance };
-    let (response, report) = pipeline.check_trajectory_with_report(&request);
+    let outcome = pipeline.check_trajectory_with_report(&request);
+    let (response, report) = &outcome;
     let time = response.time_from_start.sec as f64 + response.time_from_start.nanosec as f64 * 1e-9;
     let contact_found = !response.valid && response.fraction >= 0.0;
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     if json {
-        let contacts = report.as_ref().map_or(json!([]), |r| serde_json::to_value(&r.contacts).unwrap_or_default());
-        let object = json!({
-            "in_collision": !response.valid,
-            "time": contact_found.then_some(time),
-            "segment": (!response.valid && response.segment != -1).then_some(response.segment),
-            "fraction": contact_found.then_some(response.fraction),
-            "contacts": contacts,
-            "error": response.error,
-        });
-        writeln!(out, "{object}")?;
+        writeln!(out, "{}", outcome_json(&outcome))?;
     } else if response.valid {
         writeln!(out, "trajectory: clear")?;
     } else if contact_found {
         let segment =
             if response.segment == APPROACH_SEGMENT { "the approach from the start state".to_owned() } else { format!("segment {}", response.segment) };
         writeln!(out, "trajectory: IN COLLISION at {time:.6} s ({segment}, {:.4} of the way)", response.fraction)?;
-        if let Some(report) = &report {
+        if let Some(report) = report {
             super::check::print_contacts(&mut out, report)?;
         }
     }

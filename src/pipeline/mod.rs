@@ -24,6 +24,7 @@ mod tf_tree;
 mod trajectory;
 mod trajectory_file;
 mod trajectory_plan;
+mod trajectory_stream;
 mod validity;
 
 pub use self::report_adapter::{report_message, CheckedState};
@@ -39,6 +40,7 @@ pub(crate) use self::trajectory::TrajectoryJob;
 pub use self::trajectory::{Outcome, APPROACH_SEGMENT};
 pub use self::trajectory_file::{read_trajectory_file, MAX_TRAJECTORY_FILE_BYTES};
 pub use self::trajectory_plan::Interpolation;
+pub use self::trajectory_stream::{outcome_json, StreamedTrajectory, TrajectoryStream};
 #[cfg(feature = "ros")]
 pub(crate) use self::validity::ValidityJob;
 

@@ -93,22 +93,38 @@ impl TrajectoryJob {
     /// walk, and so does a spent [`MAX_TRAJECTORY_SUBINTERVALS`] budget (failing closed at the
     /// first segment not checked). A single point is checked as one state (after its approach).
     pub fn run(&self) -> CheckTrajectoryResponse {
-        self.run_with_budget(MAX_TRAJECTORY_SUBINTERVALS).0
+        self.run_with_budget(MAX_TRAJECTORY_SUBINTERVALS, None).0
     }
 
     /// [`TrajectoryJob::run`], with the report of the state at the first contact (its contacts
     /// as `check --json` gives them); `None` when free or refused.
     pub fn run_with_report(&self) -> Outcome {
-        self.run_with_budget(MAX_TRAJECTORY_SUBINTERVALS)
+        self.run_with_budget(MAX_TRAJECTORY_SUBINTERVALS, None)
     }
 
-    fn run_with_budget(&self, budget: u64) -> Outcome {
+    /// [`TrajectoryJob::run_with_report`] for a trajectory executed only until `until`
+    /// nanoseconds on its `time_from_start` scale (a newer one preempted it then): segments that
+    /// start later are not checked, and a first contact at or after `until` is no contact.
+    pub fn run_until(&self, until: i64) -> Outcome {
+        let outcome = self.run_with_budget(MAX_TRAJECTORY_SUBINTERVALS, Some(until));
+        let t = &outcome.0.time_from_start;
+        let at = t.sec as i64 * 1_000_000_000 + t.nanosec as i64;
+        if !outcome.0.valid && outcome.0.fraction >= 0.0 && at >= until {
+            return free();
+        }
+        outcome
+    }
+
+    fn run_with_budget(&self, budget: u64, until: Option<i64>) -> Outcome {
         let plan = match &self.plan {
             Ok(plan) => plan,
             Err(e) => return refused(e.clone()),
         };
         let mut spent = 0u64;
         let mut walk = |segment: i32, t0: i64, t1: i64, check: &dyn Fn() -> MotionReport| -> Option<Outcome> {
+            if until.is_some_and(|u| t0 >= u) {
+                return Some(free());
+            }
             if spent >= budget {
                 let error = format!(
                     "the motion checks spent the {budget} sub-intervals one request may use; {} and the segments after it not checked",
@@ -341,10 +357,10 @@ mod tests {
         // What each segment costs, and a budget spent after the second.
         let q = &job.plan.as_ref().unwrap().q;
         let cost: Vec<u64> = q.windows(2).map(|w| p.checker().check_motion(&w[0], &w[1]).subintervals).collect();
-        let r = job.run_with_budget(cost[0] + cost[1]).0;
+        let r = job.run_with_budget(cost[0] + cost[1], None).0;
         assert_eq!((r.valid, r.segment, r.fraction), (false, 2, -1.0), "{r:?}");
         assert!(r.error.starts_with("segment 2: ") && r.error.contains("segment 2 and the segments after it not checked"), "{}", r.error);
-        assert_eq!(job.run_with_budget(cost.iter().sum::<u64>()).0, free, "the whole budget checks everything");
+        assert_eq!(job.run_with_budget(cost.iter().sum::<u64>(), None).0, free, "the whole budget checks everything");
     }
 
     #[test]

@@ -16,6 +16,7 @@ mod output_error;
 mod replay_observer;
 mod replay_run;
 mod replay_summary;
+mod replay_trajectories;
 mod timeline;
 mod timeline_svg;
 

@@ -10,12 +10,13 @@ use super::cdr::decode_cdr;
 use super::output_error::OutputError;
 use super::replay_observer::{FirstWarnings, ReplayObserver};
 use super::replay_summary::{InputCount, ReplaySummary};
+use super::replay_trajectories::Trajectories;
 use super::timeline::Timeline;
 use super::timeline_svg::timeline_svg;
 use crate::checker::CheckerError;
 use crate::model::{Params, PoseSource};
-use crate::msgs::{JointState, StringMsg, TfMessage};
-use crate::pipeline::{CheckedState, Pipeline, RobotState, Skip, SkipCause};
+use crate::msgs::{JointState, JointTrajectory, StringMsg, TfMessage};
+use crate::pipeline::{CheckedState, Pipeline, RobotState, Skip, SkipCause, StreamedTrajectory};
 use std::collections::HashSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -48,6 +49,9 @@ pub struct ReplayOptions {
     pub plot: Option<PathBuf>,
     /// The output bag gets `/collisions` only: no markers, `/tf` or `/robot_description`.
     pub no_markers: bool,
+    /// A `trajectory_msgs/JointTrajectory` topic: each trajectory checked as executed, one JSON
+    /// line per trajectory in `jsonl`.
+    pub trajectory_topic: Option<String>,
 }
 
 /// Where the checked states go.
@@ -95,6 +99,14 @@ impl Outputs {
         }
         if let Some(b) = self.bag.as_mut() {
             b.report(pipeline, state, checked, log_time)?;
+        }
+        Ok(())
+    }
+
+    fn write_trajectory(&mut self, t: &StreamedTrajectory) -> Result<(), OutputError> {
+        if let Some((w, path)) = self.jsonl.as_mut() {
+            let line = t.json().to_string();
+            w.write_all(line.as_bytes()).and_then(|()| w.write_all(b"\n")).map_err(|source| OutputError::Write { path: path.clone(), source })?;
         }
         Ok(())
     }
@@ -205,6 +217,7 @@ struct Replayer<'a> {
     /// The topics robot descriptions and SRDFs are applied from (`robot_description_topic` and
     /// `robot_description_semantic_topic`, absolute); `None`: closed, as in the node.
     doors: [Option<String>; 2],
+    trajectories: Option<Trajectories>,
     t0: Option<i64>,
     read: u64,
     started: Instant,
@@ -239,6 +252,7 @@ impl<'a> Replayer<'a> {
         } else {
             Pipeline::new(params)?
         };
+        let trajectories = opts.trajectory_topic.as_deref().map(|t| Trajectories::open(&bag, t, &opts.bag)).transpose()?;
         let out = Outputs::create(opts, &bag, &pipeline, pose_source)?;
         let replayer = Replayer {
             opts,
@@ -251,6 +265,7 @@ impl<'a> Replayer<'a> {
             expected,
             pose_source,
             doors,
+            trajectories,
             t0: None,
             read: 0,
             started: Instant::now(),
@@ -269,6 +284,9 @@ impl<'a> Replayer<'a> {
         *self.input.per_topic.entry(m.topic.clone()).or_default() += 1;
         if let Some(b) = self.out.bag.as_mut() {
             b.input(&self.pipeline, &m)?;
+        }
+        if self.trajectories.as_ref().is_some_and(|t| t.topic == m.topic) {
+            return self.trajectory(&m);
         }
         let Some(state) = self.state_of(&m, seconds) else { return Ok(()) };
         for w in self.pipeline.take_warnings() {
@@ -335,8 +353,25 @@ impl<'a> Replayer<'a> {
         decoded
     }
 
+    /// A trajectory: checked once the next one arrives (or the bag ends).
+    fn trajectory(&mut self, m: &BagMessage) -> Result<(), ReplayError> {
+        let Some(msg) = decode::<JointTrajectory>(&mut self.pipeline, m, &mut self.warnings) else { return Ok(()) };
+        let done = self.trajectories.as_mut().and_then(|t| t.receive(&self.pipeline, msg, m.log_time));
+        self.trajectory_done(done)
+    }
+
+    fn trajectory_done(&mut self, done: Option<StreamedTrajectory>) -> Result<(), ReplayError> {
+        if let Some(t) = done {
+            self.summary.record_trajectory(&t);
+            self.out.write_trajectory(&t)?;
+        }
+        Ok(())
+    }
+
     /// Finishes the outputs and the summary.
     fn finish(mut self) -> Result<ReplaySummary, ReplayError> {
+        let last = self.trajectories.as_mut().and_then(Trajectories::finish);
+        self.trajectory_done(last)?;
         self.warnings.observer.finished();
         self.out.finish(&self.opts.bag)?;
         if self.pipeline.semantic_deferred() {

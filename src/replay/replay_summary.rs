@@ -28,9 +28,19 @@ pub struct ReplaySummary {
     /// failure. Messages that decode and are then refused by the pipeline (fail closed) do not
     /// set it.
     pub no_input: Option<NoInput>,
+    /// Trajectories checked (`--trajectory-topic`), and those in collision or not checkable.
+    pub trajectories: (usize, usize),
 }
 
 impl ReplaySummary {
+    /// Counts one trajectory's answer.
+    pub(super) fn record_trajectory(&mut self, t: &crate::pipeline::StreamedTrajectory) {
+        self.trajectories.0 += 1;
+        if !t.outcome.0.valid {
+            self.trajectories.1 += 1;
+        }
+    }
+
     /// Counts one report.
     pub(super) fn record(&mut self, checked: &CheckedState) {
         self.states += 1;
@@ -54,6 +64,9 @@ impl std::fmt::Display for ReplaySummary {
         }
         let per = if self.states > 0 { self.seconds / self.states as f64 * 1e6 } else { 0.0 };
         writeln!(f, "time: {:.3} s, {per:.2} us per state ({:.0} states/s)", self.seconds, self.states as f64 / self.seconds.max(1e-12))?;
+        if self.trajectories != (0, 0) {
+            writeln!(f, "trajectories: {}, in collision or not checked: {}", self.trajectories.0, self.trajectories.1)?;
+        }
         if self.descriptions != (0, 0) {
             writeln!(f, "robot descriptions: {} applied, {} refused", self.descriptions.0, self.descriptions.1)?;
         }

@@ -1,7 +1,10 @@
 """rosbag2 peer for tests/replay_bags.rs: writes input bags with rosbags, reads output bags back
 with rosbags and with mcap-ros2-support, and parses the project's .msg/.srv files.
 
-stdin: a JSON request with "op": "write" | "read" | "view" | "parse".
+stdin: a JSON request with "op": "write" | "read" | "view" | "parse". A "write" message is a
+joint state ("name"), transforms ("transforms"), raw bytes ("raw") or a trajectory ("trajectory":
+{"joint_names", "points": [{"positions", "velocities", "accelerations", "t"}]}, on
+"trajectory_topic", default /joint_trajectory_controller/joint_trajectory).
 """
 import json
 import sys
@@ -46,8 +49,22 @@ def write(req):
             w.write(c, req["messages"][0]["t"] - 1, store.serialize_cdr(String(data=req["robot_description"]), c.msgtype))
         js = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=store)
         tf = w.add_connection("/tf", "tf2_msgs/msg/TFMessage", typestore=store)
+        traj = None
+        if any("trajectory" in m for m in req["messages"]):
+            traj = w.add_connection(req.get("trajectory_topic", "/joint_trajectory_controller/joint_trajectory"),
+                                    "trajectory_msgs/msg/JointTrajectory", typestore=store)
         for m in req["messages"]:
-            if "raw" in m:  # an undecodable message
+            if "trajectory" in m:  # a trajectory_msgs/JointTrajectory, points {positions, velocities, accelerations, t}
+                JT = store.types["trajectory_msgs/msg/JointTrajectory"]
+                JTP = store.types["trajectory_msgs/msg/JointTrajectoryPoint"]
+                Duration = store.types["builtin_interfaces/msg/Duration"]
+                arr = lambda xs: np.array(xs, dtype=np.float64)
+                pts = [JTP(positions=arr(p["positions"]), velocities=arr(p.get("velocities", [])), accelerations=arr(p.get("accelerations", [])),
+                           effort=arr([]), time_from_start=Duration(sec=int(p["t"] // 1_000_000_000), nanosec=int(p["t"] % 1_000_000_000)))
+                       for p in m["trajectory"]["points"]]
+                msg = JT(header=Header(stamp=time(0, store), frame_id=""), joint_names=m["trajectory"]["joint_names"], points=pts)
+                w.write(traj, m["t"], store.serialize_cdr(msg, traj.msgtype))
+            elif "raw" in m:  # an undecodable message
                 w.write(js, m["t"], bytes(m["raw"]))
             elif "name" in m:
                 msg = JointState(header=Header(stamp=time(m["stamp"], store), frame_id=""), name=m["name"],
