@@ -5,15 +5,15 @@
 
 use super::bag_compression::looks_like_zstd;
 use super::bag_output::{OutputBag, DESCRIPTION_TOPIC};
-use super::bag_reader::{open_bag, BagError, BagMessage, BagReader};
+use super::bag_reader::{open_bag, BagMessage, BagReader};
 use super::cdr::decode_cdr;
 use super::output_error::OutputError;
+use super::replay_error::ReplayError;
 use super::replay_observer::{FirstWarnings, ReplayObserver};
 use super::replay_summary::{InputCount, ReplaySummary};
 use super::replay_trajectories::Trajectories;
 use super::timeline::Timeline;
 use super::timeline_svg::timeline_svg;
-use crate::checker::CheckerError;
 use crate::model::{Params, PoseSource};
 use crate::msgs::{JointState, JointTrajectory, StringMsg, TfMessage};
 use crate::pipeline::{CheckedState, Pipeline, RobotState, Skip, SkipCause, StreamedTrajectory};
@@ -124,67 +124,6 @@ impl Outputs {
         }
         Ok(())
     }
-}
-
-/// Why a replay cannot start or finish. Reports written before the error are kept.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum ReplayError {
-    /// The bag cannot be opened.
-    #[error(transparent)]
-    Bag(#[from] BagError),
-    /// The robot or environment cannot be loaded.
-    #[error(transparent)]
-    Checker(#[from] CheckerError),
-    /// An output cannot be written.
-    #[error(transparent)]
-    Output(#[from] OutputError),
-    /// The input topic is not in the bag.
-    #[error("topic {topic} is not in bag {} (it has: {have})", bag.display())]
-    MissingTopic {
-        /// The topic.
-        topic: String,
-        /// The bag.
-        bag: PathBuf,
-        /// The bag's topics, listed.
-        have: String,
-    },
-    /// The input topic has another type than the pose source reads.
-    #[error("topic {topic} in bag {} has type {found}; pose_source {source_name} reads {expected}", bag.display())]
-    WrongType {
-        /// The topic.
-        topic: String,
-        /// The bag.
-        bag: PathBuf,
-        /// Its type.
-        found: String,
-        /// `joint_states` or `tf`.
-        source_name: &'static str,
-        /// The type that pose source reads.
-        expected: &'static str,
-    },
-    /// The input topic is not CDR: every message would be undecodable.
-    #[error("topic {topic} in bag {} has message encoding '{encoding}'; replay decodes cdr (ROS 2's serialization) only", bag.display())]
-    Encoding {
-        /// The topic.
-        topic: String,
-        /// The bag.
-        bag: PathBuf,
-        /// Its encoding.
-        encoding: String,
-    },
-    /// The parameters' SRDF fitted no robot of the replay.
-    #[error("robot_semantic_file {file} fits neither the bundled arm nor a {DESCRIPTION_TOPIC} of bag {} ({applied} applied, {refused} refused)", bag.display())]
-    SemanticUnused {
-        /// The SRDF file.
-        file: String,
-        /// The bag.
-        bag: PathBuf,
-        /// Descriptions applied.
-        applied: usize,
-        /// Descriptions refused.
-        refused: usize,
-    },
 }
 
 /// Replays a bag, telling `observer` what it does. Reports before a corrupt tail are kept; the

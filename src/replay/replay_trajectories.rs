@@ -4,7 +4,7 @@
 //! trajectory in `--jsonl`, counted in the summary.
 
 use super::bag_reader::BagReader;
-use super::replay_run::ReplayError;
+use super::replay_error::ReplayError;
 use crate::pipeline::{Pipeline, StreamedTrajectory, TrajectoryStream};
 use std::path::Path;
 
