@@ -25,6 +25,7 @@ packages=(
     "yourdfpy==0.0.60"          # an independent URDF parser and FK
     "xacro==2.1.1"              # ROS's xacro, to expand MoveIt's .xacro configs as users do
     "zstandard==0.25.0"         # zstd bindings: compresses bags as rosbag2 does (tests/replay_compressed.rs)
+    "ruckig==0.19.4"            # jerk-limited time parameterisation (benches/trajectory.rs's trajectories)
 )
 stamp="$venv/.tc-packages"
 want="$("$python" -c 'import sys; print(sys.version.split()[0])') ${packages[*]}"

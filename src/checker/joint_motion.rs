@@ -42,7 +42,7 @@ struct JointPath<'a> {
 /// the velocity of `p` relative to `o_j` is at most `W_j r_j` (joints above `j` turning the
 /// pair) plus the speed bound (joints from `j` down). So a revolute `j` adds
 /// `|Δq_j| (2 W_j r_j + speed)`, a prismatic one `|Δq_j| W_j`.
-fn point_acceleration(robot: &RobotModel, levers: &[(usize, Real)], delta: &[f64], speed: Real) -> Real {
+pub(super) fn point_acceleration(robot: &RobotModel, levers: &[(usize, Real)], delta: &[f64], speed: Real) -> Real {
     let mut above = 0.0;
     let mut total = 0.0;
     // From the top of the chain down, so that `above` is `W_j` at each joint.

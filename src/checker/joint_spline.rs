@@ -47,6 +47,8 @@ struct SplinePath<'a> {
     polys: Vec<SegmentPoly>,
     turning: Vec<Vec<f64>>,
     tolerance: Vec<f64>,
+    /// Per joint: the first and second derivatives, each with its turning points.
+    rates: Vec<[(SegmentPoly, Vec<f64>); 2]>,
     /// Per target: `Σ_j (top speed_j + τ_j) r_jk`, positive whenever the target can move.
     speeds: Vec<Real>,
     /// Per target: `Σ_j τ_j r_jk`.
@@ -112,6 +114,40 @@ impl SplinePath<'_> {
     }
 }
 
+impl SplinePath<'_> {
+    /// The first-order bound of [`MotionPath::bound`], without the tolerance's share.
+    fn first_order(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
+        let robot = self.checker.robot();
+        let bounds = self.checker.motion_bounds();
+        let Some(link) = poses[self.checker.targets()[ti].link] else { return Real::INFINITY };
+        let (centre, radius) = bounds.ball[ti];
+        let c = link * centre;
+        let (a, b) = ((mid - half).max(0.0), (mid + half).min(1.0));
+        let (mut omega, mut velocity, mut rates) = (Vector::ZERO, Vector::ZERO, 0.0);
+        let mut top = vec![0.0; self.polys.len()];
+        for &(j, r) in &self.levers[ti] {
+            let joint = &robot.joints[j];
+            let [(d1, t1), (d2, t2)] = &self.rates[j];
+            let rate = d1.at(mid);
+            top[j] = d1.max_abs(t1, a, b);
+            rates += d2.max_abs(t2, a, b) * r;
+            let Some(child) = poses[joint.child] else { return Real::INFINITY };
+            let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
+            match joint.kind {
+                JointKind::Revolute | JointKind::Continuous => {
+                    omega += axis * rate;
+                    velocity += axis.cross(c - child.translation) * rate;
+                }
+                JointKind::Prismatic => velocity += axis * rate,
+                _ => {}
+            }
+        }
+        let speed: Real = self.levers[ti].iter().map(|(j, r)| top[*j] * r).sum();
+        let acceleration = rates + super::joint_motion::point_acceleration(robot, &self.levers[ti], &top, speed);
+        half * (velocity.length() + omega.length() * radius) + 0.5 * half * half * acceleration
+    }
+}
+
 impl MotionPath for SplinePath<'_> {
     fn speeds(&self) -> &[Real] {
         &self.speeds
@@ -122,8 +158,23 @@ impl MotionPath for SplinePath<'_> {
         Ok(poses.iter().map(|p| Some(pose_from_isometry(p))).collect())
     }
 
+    /// The smaller of the lever bound over the joints' excursions and a first-order one: the
+    /// link's points move at most `h·(|v_c| + |ω| R) + h²/2 · A` from where they are at the
+    /// middle, with the velocity of a point `c` of the link and its angular velocity at the
+    /// middle, `R` the radius of a ball about `c` holding the link, and `A` a bound on the
+    /// acceleration of its points over the stretch: `p̈ = Σ_j q̈_j u_j + Σ_j q̇_j u̇_j`, so the
+    /// largest `|q̈_j|` times the lever plus `point_acceleration` at the largest `|q̇_j|` (both
+    /// over the stretch, from the polynomials). Plus the tolerance's share, which no stretch
+    /// narrows.
     fn bound(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
-        self.bound_with(ti, poses, &self.excursions(mid, half))
+        let levers = self.bound_with(ti, poses, &self.excursions(mid, half));
+        let first_order = self.first_order(ti, poses, mid, half) + self.floors[ti];
+        // NaN (a bad pose) falls back to the lever bound.
+        if first_order < levers {
+            first_order
+        } else {
+            levers
+        }
     }
 
     fn report_at(&self, s: f64) -> StateReport {
@@ -187,6 +238,13 @@ impl Checker {
             }
         }
         let turning: Vec<Vec<f64>> = polys.iter().map(SegmentPoly::turning_points).collect();
+        let rates = polys
+            .iter()
+            .map(|p| {
+                let (d1, d2) = (p.derivative(), p.derivative().derivative());
+                [(d1, d1.turning_points()), (d2, d2.turning_points())]
+            })
+            .collect();
         let top: Vec<f64> = polys.iter().map(SegmentPoly::top_speed).collect();
         // How far each prismatic joint strays past the larger magnitude of its limits.
         let overshoot: Vec<f64> = (0..n)
@@ -218,7 +276,7 @@ impl Checker {
             .collect();
         let speeds = levers.iter().map(|l| l.iter().map(|(j, r)| (top[*j] + tolerance[*j]) * r).sum()).collect();
         let floors = levers.iter().map(|l| l.iter().map(|(j, r)| tolerance[*j] * r).sum()).collect();
-        Ok(SplinePath { checker: self, segment, polys, turning, tolerance, speeds, floors, levers })
+        Ok(SplinePath { checker: self, segment, polys, turning, tolerance, rates, speeds, floors, levers })
     }
 }
 

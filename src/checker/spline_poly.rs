@@ -78,7 +78,7 @@ impl SegmentPoly {
     }
 
     /// The derivative, `d/ds`.
-    fn derivative(&self) -> SegmentPoly {
+    pub(crate) fn derivative(&self) -> SegmentPoly {
         let mut c = [0.0; 6];
         for k in 1..6 {
             c[k - 1] = self.c[k] * k as f64;
@@ -109,6 +109,12 @@ impl SegmentPoly {
     pub fn range(&self, turning: &[f64]) -> (f64, f64) {
         let values = turning.iter().map(|&r| self.at(r)).chain([self.at(0.0), self.at(1.0)]);
         values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)))
+    }
+
+    /// The largest `|self(s)|` over `[a, b]`, given the turning points.
+    pub fn max_abs(&self, turning: &[f64], a: f64, b: f64) -> f64 {
+        let ends = self.at(a).abs().max(self.at(b).abs());
+        turning.iter().filter(|&&r| r > a && r < b).fold(ends, |m, &r| m.max(self.at(r).abs()))
     }
 
     /// The largest `|self'(s)|` over `[0, 1]`: how fast the joint moves per unit of `s`.
