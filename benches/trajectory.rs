@@ -38,6 +38,9 @@ struct Sampled {
     a: Vec<Vec<f64>>,
 }
 
+/// A planner-like edge: start and end positions, start and end velocities (every joint).
+type Edge = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
+
 fn main() {
     let segments = env_usize("SEGMENTS", 2_000);
     let trajectories = env_usize("TRAJECTORIES", 20);
@@ -54,7 +57,7 @@ fn main() {
     let arm: Vec<usize> = (1..=7).map(|i| checker.robot().joint(&format!("panda_joint{i}")).unwrap()).collect();
     let mut rng = Rand64::new(2026);
     let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
-    let edges: Vec<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> = (0..segments)
+    let edges: Vec<Edge> = (0..segments)
         .map(|_| {
             let (mut q0, mut q1, mut v0, mut v1) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
             for &j in &arm {
