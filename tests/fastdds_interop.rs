@@ -117,11 +117,12 @@ fn fastdds_topics_services_parameters_and_latched_markers() {
         assert_same_report(&r2[k], &reference[k + 2], &format!("check_states client 1, state {}", k + 2));
     }
 
-    // check_trajectory: answers equal check --motion on the same waypoints.
+    // check_trajectory along the chords (`interpolation: linear`): answers equal check --motion on
+    // the same waypoints.
     let trajectories: Vec<Vec<usize>> = vec![vec![0, 1, 2, 3, 4, 5], vec![6, 6], vec![10, 11, 12]];
     let requests: Vec<Value> = trajectories
         .iter()
-        .map(|t| json!({"joint_names": NAMES, "points": t.iter().enumerate().map(|(i, &k)| json!({"positions": state(k), "t": 1_000_000_000 * (i as i64 + 1)})).collect::<Vec<_>>()}))
+        .map(|t| json!({"joint_names": NAMES, "interpolation": "linear", "points": t.iter().enumerate().map(|(i, &k)| json!({"positions": state(k), "t": 1_000_000_000 * (i as i64 + 1)})).collect::<Vec<_>>()}))
         .collect();
     let answers = peer.call("check_trajectory", "check_trajectory", requests, 30.0);
     let mut invalid = 0;

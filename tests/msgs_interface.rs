@@ -87,13 +87,14 @@ fn check_trajectory_srv_matches_the_rust_types() {
         names.into_iter().map(|n| n.1).collect()
     };
     let (req, resp) = (fields(request), fields(response));
-    assert_eq!(req, [("trajectory_msgs/JointTrajectory".to_owned(), "trajectory".to_owned())]);
+    let want_req = [("trajectory_msgs/JointTrajectory", "trajectory"), ("string", "interpolation"), ("float64[]", "path_tolerance")];
+    assert_eq!(req, want_req.map(|(t, n)| (t.to_owned(), n.to_owned())));
     let req_keys = keys(serde_json::to_string(&thickness_collision::msgs::CheckTrajectoryRequest::default()).unwrap());
     assert_eq!(req.iter().map(|f| f.1.clone()).collect::<Vec<_>>(), req_keys);
     let resp_keys = keys(serde_json::to_string(&thickness_collision::msgs::CheckTrajectoryResponse::default()).unwrap());
     assert_eq!(resp.iter().map(|f| f.1.clone()).collect::<Vec<_>>(), resp_keys);
     let types: Vec<&str> = resp.iter().map(|f| f.0.as_str()).collect();
-    assert_eq!(types, ["bool", "int32", "float64", "builtin_interfaces/Duration", "Contact[]", "string"]);
+    assert_eq!(types, ["bool", "int32", "float64", "builtin_interfaces/Duration", "Contact[]", "string", "Clearance[]"]);
     // trajectory_msgs/JointTrajectory and JointTrajectoryPoint as ROS defines them.
     let traj = keys(serde_json::to_string(&thickness_collision::msgs::JointTrajectory::default()).unwrap());
     assert_eq!(traj, ["header", "joint_names", "points"]);

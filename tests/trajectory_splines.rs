@@ -415,3 +415,71 @@ fn a_tube_is_refused_only_when_it_can_reach_a_sheet() {
     }
     assert!(refused > 0, "some joint's 3 cm tube must reach the sheet");
 }
+
+/// The path clearance (issue 34, part 4): with `clearance_threshold` 0.15 m, the bundled arm's free
+/// executed trajectories report per link the smallest clearance over the path, never above the
+/// least clearance a dense sampling finds (no point moves 0.1 mm between samples) and at most
+/// 1 mm (plus the sampling's 0.1 mm) below it; every link the sampling finds within the threshold
+/// is reported.
+#[test]
+fn the_path_clearance_is_within_a_millimetre_below_the_sampled_minimum() {
+    let threshold = 0.15;
+    let mut pipeline = Pipeline::new(Params { clearance_threshold: threshold, ..Params::default() }).unwrap();
+    let c = pipeline.checker().clone();
+    let robot = c.robot();
+    let names: Vec<String> = robot.joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
+    let index: Vec<usize> = names.iter().map(|n| robot.joint(n).unwrap()).collect();
+    let full = |named: &[f64]| -> Vec<f64> {
+        let mut q = vec![0.0; robot.joints.len()];
+        index.iter().zip(named).for_each(|(&j, &x)| q[j] = x);
+        q
+    };
+    let reach = index.iter().map(|&j| lever_bound(&c, j)).fold(0.0, f64::max);
+    let continuous: Vec<bool> = index.iter().map(|&j| robot.joints[j].kind == thickness_collision::model::JointKind::Continuous).collect();
+    let mut rng = Rand64::new(4);
+    let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
+    let (mut compared, mut tries) = (0, 0);
+    while compared < 8 && tries < 200 {
+        tries += 1;
+        let start: Vec<f64> = index.iter().map(|&j| robot.joints[j].limits).map(|[lo, hi]| draw(lo.max(-1.5), hi.min(1.5))).collect();
+        let mut p = start.clone();
+        let points: Vec<(End, f64)> = (0..2)
+            .map(|k| {
+                p = p.iter().map(|x| x + draw(-0.3, 0.3)).collect();
+                (End { p: p.clone(), v: (0..p.len()).map(|_| draw(-0.4, 0.4)).collect(), a: Vec::new() }, 0.5 + k as f64)
+            })
+            .collect();
+        pipeline.joint_state(&JointState { name: names.clone(), position: start.clone(), ..Default::default() }).unwrap();
+        let r = pipeline.check_trajectory(&request(&names, &points, ""));
+        if !r.valid || r.clearances.is_empty() {
+            continue;
+        }
+        let startend = End { p: start.clone(), v: vec![0.0; start.len()], a: Vec::new() };
+        let mut sampled: std::collections::BTreeMap<String, f64> = Default::default();
+        for (segment, _) in executed(&startend, &points, &continuous) {
+            let n = ((reach * segment.samples() as f64 * STEP / REACH) / 1e-4).ceil() as usize;
+            for k in 0..=n {
+                let q = full(&segment.at(segment.duration * k as f64 / n as f64));
+                for cl in c.check_positions(&q).unwrap().clearances {
+                    let e = sampled.entry(cl.link_name.clone()).or_insert(f64::INFINITY);
+                    *e = e.min(cl.distance);
+                }
+            }
+        }
+        for (link, &least) in &sampled {
+            let got = r.clearances.iter().find(|x| &x.link_name == link).unwrap_or_else(|| panic!("{link} comes {least} m near but is not reported: {r:?}"));
+            assert!(got.distance <= least + 1e-9, "{link}: reported {} above the sampled minimum {least}", got.distance);
+            assert!(got.distance >= least - 1.1e-3, "{link}: reported {} more than 1 mm below the sampled minimum {least}", got.distance);
+        }
+        for got in &r.clearances {
+            assert!(
+                sampled.contains_key(&got.link_name) || got.distance >= threshold - 1.1e-3,
+                "{} reported at {} but never sampled within the threshold",
+                got.link_name,
+                got.distance
+            );
+        }
+        compared += 1;
+    }
+    assert_eq!(compared, 8, "eight free trajectories with clearances compared ({tries} tried)");
+}

@@ -40,7 +40,7 @@ impl SplineSegment {
 }
 
 /// A segment as the adaptive loop sees it.
-struct SplinePath<'a> {
+pub(super) struct SplinePath<'a> {
     checker: &'a Checker,
     segment: &'a SplineSegment,
     /// Per joint (mimics resolved): the polynomial, its turning points, its tolerance.
@@ -213,7 +213,7 @@ impl Checker {
         }
     }
 
-    fn spline_path<'a>(&'a self, segment: &'a SplineSegment) -> Result<SplinePath<'a>, String> {
+    pub(super) fn spline_path<'a>(&'a self, segment: &'a SplineSegment) -> Result<SplinePath<'a>, String> {
         let robot = self.robot();
         let n = robot.joints.len();
         if segment.joints.len() != n {

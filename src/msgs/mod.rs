@@ -484,4 +484,8 @@ pub struct CheckTrajectoryResponse {
     pub contacts: Vec<ContactMsg>,
     /// Why the trajectory was refused or could not be checked; empty otherwise.
     pub error: String,
+    /// With `clearance_threshold` set: per link within it somewhere on the path (up to the first
+    /// contact), its smallest clearance over the path, never above the true minimum and at most
+    /// 1 mm below it; empty otherwise.
+    pub clearances: Vec<ClearanceMsg>,
 }

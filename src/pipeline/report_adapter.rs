@@ -64,7 +64,7 @@ pub fn report_message(report: &StateReport, stamp: Time, frame: &str) -> Collisi
 }
 
 /// The `Clearance` message of one link's clearance.
-fn clearance_message(c: &ReportClearance) -> ClearanceMsg {
+pub(crate) fn clearance_message(c: &ReportClearance) -> ClearanceMsg {
     let p = |a: [f64; 3]| Point { x: a[0], y: a[1], z: a[2] };
     ClearanceMsg {
         link_name: c.link_name.clone(),

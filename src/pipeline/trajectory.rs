@@ -144,11 +144,23 @@ impl TrajectoryJob {
         };
         match plan.interpolation {
             Interpolation::Executed => {
+                let mut nearest = PathClearance::default();
                 for (index, segment, t0, t1) in plan.executed_segments() {
                     let number = index.map_or(APPROACH_SEGMENT, |i| i as i32);
-                    if let Some(answer) = walk(number, t0, t1, &|| self.checker.check_spline(&segment)) {
+                    if until.is_none_or(|u| t0 < u) {
+                        if let Err(e) = nearest.add(&self.checker, &segment) {
+                            return self.answer(number, StateReport::failed(e), -1.0, DurationMsg::default());
+                        }
+                    }
+                    if let Some(mut answer) = walk(number, t0, t1, &|| self.checker.check_spline(&segment)) {
+                        nearest.into_response(&mut answer.0);
                         return answer;
                     }
+                }
+                if plan.q.len() > 1 {
+                    let mut answer = free();
+                    nearest.into_response(&mut answer.0);
+                    return answer;
                 }
             }
             Interpolation::Linear => {
@@ -192,8 +204,40 @@ impl TrajectoryJob {
             report.error = format!("{}: {}", segment_name(segment), report.error);
         }
         let message = super::report_message(&report, Time::default(), frame);
-        let response = CheckTrajectoryResponse { valid: false, segment, fraction, time_from_start: t, contacts: message.contacts, error: report.error.clone() };
+        let response = CheckTrajectoryResponse {
+            valid: false,
+            segment,
+            fraction,
+            time_from_start: t,
+            contacts: message.contacts,
+            error: report.error.clone(),
+            clearances: Vec::new(),
+        };
         (response, Some(report))
+    }
+}
+
+/// The smallest clearance of each link over the segments walked so far.
+#[derive(Default)]
+struct PathClearance {
+    nearest: Vec<crate::checker::ReportClearance>,
+}
+
+impl PathClearance {
+    /// Folds in one segment's (nothing when `clearance_threshold` is 0).
+    fn add(&mut self, checker: &Checker, segment: &crate::checker::SplineSegment) -> Result<(), String> {
+        for c in checker.spline_clearances(segment)? {
+            match self.nearest.iter_mut().find(|n| n.link_name == c.link_name) {
+                Some(n) if c.distance < n.distance => *n = c,
+                Some(_) => {}
+                None => self.nearest.push(c),
+            }
+        }
+        Ok(())
+    }
+
+    fn into_response(self, response: &mut CheckTrajectoryResponse) {
+        response.clearances = self.nearest.iter().map(super::report_adapter::clearance_message).collect();
     }
 }
 

@@ -40,12 +40,23 @@ impl StreamedTrajectory {
 
 /// A trajectory's answer as `check --trajectory --json` prints it: `in_collision`, `time` (seconds
 /// on the `time_from_start` scale; `null` when free or not found), `segment` (`null` when free or
-/// refused; -2 the approach), `fraction`, `contacts` (as `check --json`), `error`.
+/// refused; -2 the approach), `fraction`, `contacts` (as `check --json`), `clearances` (the
+/// smallest per link over the path, with `clearance_threshold`), `error`.
 pub fn outcome_json((response, report): &Outcome) -> serde_json::Value {
     let time = response.time_from_start.sec as f64 + response.time_from_start.nanosec as f64 * 1e-9;
     let contact_found = !response.valid && response.fraction >= 0.0;
     let contacts = report.as_ref().map_or(json!([]), |r| serde_json::to_value(&r.contacts).unwrap_or_default());
+    let point = |p: &crate::msgs::Point| [p.x, p.y, p.z];
+    let clearances: Vec<serde_json::Value> = response
+        .clearances
+        .iter()
+        .map(|c| {
+            json!({"link_name": c.link_name, "object_name": c.object_name, "triangle": c.triangle, "distance": c.distance,
+                   "point_on_link": point(&c.point_on_link), "point_on_object": point(&c.point_on_object)})
+        })
+        .collect();
     json!({
+        "clearances": clearances,
         "in_collision": !response.valid,
         "time": contact_found.then_some(time),
         "segment": (!response.valid && response.segment != -1).then_some(response.segment),

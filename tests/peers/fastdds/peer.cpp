@@ -651,6 +651,8 @@ std::string cmd_call(Peer& peer, const pj::Value& cmd) {
                 Req r;
                 r.trajectory().header().frame_id("world");
                 r.trajectory().joint_names(q["joint_names"].strs());
+                if (q.has("interpolation")) r.interpolation(q["interpolation"].str());
+                if (q.has("path_tolerance")) r.path_tolerance(q["path_tolerance"].nums());
                 for (const auto& p : q["points"].arr()) {
                     trajectory_msgs::msg::JointTrajectoryPoint pt;
                     pt.positions(p["positions"].nums());
