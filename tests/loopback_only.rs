@@ -21,8 +21,6 @@ mod common;
 use common::fastdds::{FastDdsPeer, PeerOptions};
 use common::netns::{LoopbackHost, SECOND_ADDRESS};
 use serde_json::{json, Value};
-use std::io::Write;
-use std::process::{Command, Stdio};
 
 /// A Cyclone DDS configuration for interface `address`, no multicast, the peer 127.0.0.1.
 fn cyclone_config(address: &str) -> String {
@@ -33,22 +31,7 @@ fn cyclone_config(address: &str) -> String {
 fn cyclone_peer(host: &LoopbackHost, dir: &std::path::Path, config: &str, request: &Value) -> Value {
     let file = dir.join(format!("cyclone_{}.xml", if config.contains(SECOND_ADDRESS) { "second" } else { "loopback" }));
     std::fs::write(&file, config).unwrap();
-    let script = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
-    let wrapper = host.wrapper();
-    let mut child = Command::new(&wrapper[0])
-        .args(&wrapper[1..])
-        .arg(common::python())
-        .arg(&script)
-        .env("CYCLONEDDS_URI", format!("file://{}", file.display()))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start the Cyclone peer");
-    child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
-    let o = child.wait_with_output().unwrap();
-    assert!(o.status.success(), "dds_peer.py: {}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("dds_peer.py answered no JSON ({e}): {}", String::from_utf8_lossy(&o.stdout)))
+    common::run_cyclone_peer_in(&host.wrapper(), "dds_peer.py", &file, &request.to_string())
 }
 
 fn states() -> Vec<Value> {

@@ -266,6 +266,22 @@ fn executed_trajectories_agree_with_dense_sampling() {
     assert!(bulges >= 3, "some executed splines must cross what their chords miss: {bulges}");
 }
 
+/// The actuated joints' names and indices, and the positions of every joint given theirs (the
+/// others at 0).
+#[allow(clippy::type_complexity)]
+fn actuated(c: &Checker) -> (Vec<String>, Vec<usize>, Box<dyn Fn(&[f64]) -> Vec<f64> + '_>) {
+    let robot = c.robot();
+    let names: Vec<String> = robot.joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
+    let index: Vec<usize> = names.iter().map(|n| robot.joint(n).unwrap()).collect();
+    let at = index.clone();
+    let full = move |named: &[f64]| -> Vec<f64> {
+        let mut q = vec![0.0; robot.joints.len()];
+        at.iter().zip(named).for_each(|(&j, &x)| q[j] = x);
+        q
+    };
+    (names, index, Box::new(full))
+}
+
 /// The farthest any point of a link that joint `j` moves can be from `j`'s axis, in any
 /// configuration: the joint origins' distances along the chain below it plus the link's reach
 /// (the lever bound of the motion check, recomputed here from the model).
@@ -310,13 +326,7 @@ fn a_tube_is_refused_only_when_it_can_reach_a_sheet() {
     let mut pipeline = Pipeline::new(params).unwrap();
     let c = pipeline.checker().clone();
     let robot = c.robot();
-    let names: Vec<String> = robot.joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
-    let index: Vec<usize> = names.iter().map(|n| robot.joint(n).unwrap()).collect();
-    let full = |named: &[f64]| -> Vec<f64> {
-        let mut q = vec![0.0; robot.joints.len()];
-        index.iter().zip(named).for_each(|(&j, &x)| q[j] = x);
-        q
-    };
+    let (names, index, full) = actuated(&c);
     let clearance = |named: &[f64]| -> (f64, String) {
         let r = c.check_positions(&full(named)).unwrap();
         if r.in_collision {
@@ -427,13 +437,7 @@ fn the_path_clearance_is_within_a_millimetre_below_the_sampled_minimum() {
     let mut pipeline = Pipeline::new(Params { clearance_threshold: threshold, ..Params::default() }).unwrap();
     let c = pipeline.checker().clone();
     let robot = c.robot();
-    let names: Vec<String> = robot.joints.iter().filter(|j| j.is_actuated()).map(|j| j.name.clone()).collect();
-    let index: Vec<usize> = names.iter().map(|n| robot.joint(n).unwrap()).collect();
-    let full = |named: &[f64]| -> Vec<f64> {
-        let mut q = vec![0.0; robot.joints.len()];
-        index.iter().zip(named).for_each(|(&j, &x)| q[j] = x);
-        q
-    };
+    let (names, index, full) = actuated(&c);
     let reach = index.iter().map(|&j| lever_bound(&c, j)).fold(0.0, f64::max);
     let continuous: Vec<bool> = index.iter().map(|&j| robot.joints[j].kind == thickness_collision::model::JointKind::Continuous).collect();
     let mut rng = Rand64::new(4);

@@ -21,7 +21,7 @@ use common::fastdds::{FastDdsPeer, PeerOptions};
 use common::netns::{TwoHosts, HOST_A, HOST_B};
 use serde_json::{json, Value};
 use std::io::Read;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command};
 use std::time::Instant;
 
 /// The Cyclone DDS peer in host B: its veth address only, multicast as asked, `peers` as unicast
@@ -35,28 +35,9 @@ fn cyclone_config(multicast: bool, peers: &[&str]) -> String {
 
 /// Runs `tests/peers/dds_peer.py` in host B with `config`; returns its JSON answer.
 fn run_peer_in_b(hosts: &TwoHosts, config: &str, request: &Value) -> Value {
-    let dir = scratch();
-    let file = dir.join(format!("cyclone_{}.xml", request["domain"]));
+    let file = scratch().join(format!("cyclone_{}.xml", request["domain"]));
     std::fs::write(&file, config).unwrap();
-    let script = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers/dds_peer.py");
-    let wrapper = hosts.in_b();
-    let mut child = Command::new(&wrapper[0])
-        .args(&wrapper[1..])
-        .arg(common::python())
-        .arg(&script)
-        .env("CYCLONEDDS_URI", format!("file://{}", file.display()))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start the Cyclone peer in host B");
-    {
-        use std::io::Write;
-        child.stdin.take().unwrap().write_all(request.to_string().as_bytes()).unwrap();
-    }
-    let o = child.wait_with_output().unwrap();
-    assert!(o.status.success(), "dds_peer.py in host B: {}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("dds_peer.py answered no JSON ({e}): {}", String::from_utf8_lossy(&o.stdout)))
+    common::run_cyclone_peer_in(&hosts.in_b(), "dds_peer.py", &file, &request.to_string())
 }
 
 fn scratch() -> std::path::PathBuf {

@@ -100,8 +100,24 @@ pub fn run_cyclone_peer(script: &str, cyclone: &Path, request: &str) -> serde_js
 }
 
 fn run_peer_env(script: &str, env: &[(&str, String)], request: &str) -> serde_json::Value {
+    run_peer_wrapped(&[], script, env, request)
+}
+
+/// [`run_cyclone_peer`] through `wrapper` (e.g. `ip netns exec <ns>`: a test's own host).
+pub fn run_cyclone_peer_in(wrapper: &[String], script: &str, cyclone: &Path, request: &str) -> serde_json::Value {
+    run_peer_wrapped(wrapper, script, &[("CYCLONEDDS_URI", format!("file://{}", cyclone.display()))], request)
+}
+
+fn run_peer_wrapped(wrapper: &[String], script: &str, env: &[(&str, String)], request: &str) -> serde_json::Value {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/peers").join(script);
-    let mut command = Command::new(python());
+    let mut command = match wrapper.split_first() {
+        Some((first, rest)) => {
+            let mut c = Command::new(first);
+            let _ = c.args(rest).arg(python());
+            c
+        }
+        None => Command::new(python()),
+    };
     let _ = command.arg(&path).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped());
     for (k, v) in env {
         let _ = command.env(k, v);
