@@ -168,30 +168,13 @@ fn coal_moveit(
     dense_steps: DenseSteps,
 ) {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("motion_coal");
-    std::fs::create_dir_all(&dir).unwrap();
-    // The link parts as hulls, as benches/peer_compare_core.rs gives them to the peers.
-    let mut parts = Vec::new();
-    for (ti, t) in checker.targets().iter().enumerate() {
-        for (shape, offset) in &t.parts {
-            match shape {
-                TargetShape::Polytope(h) => parts.push((ti, h.clone(), *offset)),
-                other => panic!("link {}: the peers get convex hulls only, not {other:?}", t.name),
-            }
-        }
-    }
-    peer_compare_core::scaffold::write_le(&dir.join("env_vertices.f64"), world_vertices);
-    peer_compare_core::scaffold::write_le(&dir.join("env_triangles.u32"), world_triangles);
-    for (i, (_, hull, _)) in parts.iter().enumerate() {
-        let (pts, tri) = hull.vertices_and_triangles();
-        peer_compare_core::scaffold::write_le(&dir.join(format!("part{i}_vertices.f64")), &pts);
-        peer_compare_core::scaffold::write_le(&dir.join(format!("part{i}_triangles.u32")), &tri);
-    }
+    let parts = peer_compare_core::write_coal_inputs(&dir, checker, world_vertices, world_triangles);
     let robot = checker.robot();
     let mut poses: Vec<f64> = Vec::with_capacity(pairs.len() * MOVEIT_STATES * parts.len() * 12);
     for (q0, q1) in pairs {
         for k in 0..MOVEIT_STATES {
             let links = robot.forward_kinematics(&along(q0, q1, k as f64 / (MOVEIT_STATES - 1) as f64), checker.base_pose()).unwrap();
-            for (ti, _, offset) in &parts {
+            for (ti, offset) in &parts {
                 let p = pose_from_isometry(&links[checker.targets()[*ti].link]) * *offset;
                 poses.extend_from_slice(&thickness_collision::math::pose_rows(&p));
             }

@@ -252,3 +252,27 @@ pub fn compare(py: &Path, robot: &RobotModel, map: &[String], states: &[(Vec<Str
     }
     cmp
 }
+
+/// The world's triangles and the checker's link parts (as hulls) written for
+/// `benches/coal_motion.py` into `dir`; returns each part's target index and offset, in the order
+/// the poses must follow.
+pub fn write_coal_inputs(dir: &Path, checker: &Checker, world_vertices: &[[f64; 3]], world_triangles: &[[u32; 3]]) -> Vec<(usize, Pose)> {
+    std::fs::create_dir_all(dir).unwrap();
+    let mut parts = Vec::new();
+    for (ti, t) in checker.targets().iter().enumerate() {
+        for (shape, offset) in &t.parts {
+            match shape {
+                TargetShape::Polytope(h) => {
+                    let (pts, tri) = h.vertices_and_triangles();
+                    scaffold::write_le(&dir.join(format!("part{}_vertices.f64", parts.len())), &pts);
+                    scaffold::write_le(&dir.join(format!("part{}_triangles.u32", parts.len())), &tri);
+                    parts.push((ti, *offset));
+                }
+                other => panic!("link {}: the peers get convex hulls only, not {other:?}", t.name),
+            }
+        }
+    }
+    scaffold::write_le(&dir.join("env_vertices.f64"), world_vertices);
+    scaffold::write_le(&dir.join("env_triangles.u32"), world_triangles);
+    parts
+}

@@ -49,6 +49,7 @@ fn main() {
     let (robot, map) = peer_compare_core::panda(&py);
     let world = peer_compare_core::world(1_000_000);
     let cells = world.scene.cell_count();
+    let (world_vertices, world_triangles) = (world.vertices.clone(), world.triangles.clone());
     let params = Params { package_map: map.clone(), ..Params::default() };
     let tol = params.motion_tolerance;
     let checker = Checker::from_robot_and_scene(params, robot.clone(), world.scene, "panda".into()).unwrap();
@@ -148,17 +149,20 @@ fn main() {
         (false, spent)
     };
     let all: Vec<Vec<SplineSegment>> = sampled.iter().map(segments_of).collect();
-    let (mut ours, mut colliding) = (0.0, 0usize);
+    let (mut ours, mut colliding, mut verdicts) = (0.0, 0usize, Vec::new());
     for segs in &all {
         let started = Instant::now();
-        colliding += check(segs).0 as usize;
+        let hit = check(segs).0;
         ours += started.elapsed().as_secs_f64();
+        colliding += hit as usize;
+        verdicts.push(hit);
     }
     println!(
         "| {trajectories} ruckig trajectories, 100 points, 7 joints ({:.1} s long on average): ours, mean per trajectory | {:.2} ms ({colliding} in collision) |",
         sampled.iter().map(|s| s.t[s.t.len() - 1]).sum::<f64>() / trajectories as f64,
         ours / trajectories as f64 * 1e3
     );
+    coal_moveit(&py, &checker, &sampled, &full, &world_vertices, &world_triangles, ours, &verdicts);
     if dense == 0 {
         return;
     }
@@ -189,4 +193,74 @@ fn main() {
     );
     println!("| ours on the same {dense} | {:.2} ms per trajectory |", ours_seconds / dense as f64 * 1e3);
     println!("| dense sampling / ours | **{:.1}** |", dense_seconds / ours_seconds);
+}
+
+/// coal with MoveIt-style validation of the same trajectories (`benches/coal_motion.py`, the
+/// environment only): every waypoint and, between two, the straight chord sampled every
+/// `longest_valid_segment_fraction` 0.005 of the joint-space extent (MoveIt's distance: the sum of
+/// the joints' distances; the extent: the sum of their ranges), stopping at the first colliding
+/// state. No guarantee between samples, and the chords are not the executed splines.
+#[allow(clippy::too_many_arguments)]
+fn coal_moveit(
+    py: &std::path::Path,
+    checker: &Checker,
+    sampled: &[Sampled],
+    full: &dyn Fn(&[f64]) -> Vec<f64>,
+    world_vertices: &[[f64; 3]],
+    world_triangles: &[[u32; 3]],
+    ours: f64,
+    verdicts: &[bool],
+) {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("trajectory_coal");
+    let parts = peer_compare_core::write_coal_inputs(&dir, checker, world_vertices, world_triangles);
+    let robot = checker.robot();
+    let arm: Vec<usize> = (1..=7).map(|i| robot.joint(&format!("panda_joint{i}")).unwrap()).collect();
+    let extent: f64 = arm.iter().map(|&j| robot.joints[j].limits[1] - robot.joints[j].limits[0]).sum();
+    let step = 0.005 * extent;
+    let states: Vec<Vec<Vec<f64>>> = sampled
+        .iter()
+        .map(|s| {
+            let mut out = Vec::new();
+            for w in s.p.windows(2) {
+                let d: f64 = w[0].iter().zip(&w[1]).map(|(a, b)| (b - a).abs()).sum();
+                let n = ((d / step).ceil() as usize).max(1);
+                out.extend((0..n).map(|k| full(&w[0].iter().zip(&w[1]).map(|(a, b)| a + (b - a) * k as f64 / n as f64).collect::<Vec<_>>())));
+            }
+            out.push(full(&s.p[s.p.len() - 1]));
+            out
+        })
+        .collect();
+    let longest = states.iter().map(Vec::len).max().unwrap_or(0);
+    let mut poses: Vec<f64> = Vec::with_capacity(states.len() * longest * parts.len() * 12);
+    for trajectory in &states {
+        for k in 0..longest {
+            let q = &trajectory[k.min(trajectory.len() - 1)];
+            let links = robot.forward_kinematics(q, checker.base_pose()).unwrap();
+            for (ti, offset) in &parts {
+                let p = thickness_collision::math::pose_from_isometry(&links[checker.targets()[*ti].link]) * *offset;
+                poses.extend_from_slice(&thickness_collision::math::pose_rows(&p));
+            }
+        }
+    }
+    peer_compare_core::scaffold::write_le(&dir.join("motion_poses.f64"), &poses);
+    let counts: Vec<usize> = states.iter().map(Vec::len).collect();
+    let meta = serde_json::json!({"motions": states.len(), "samples": longest, "parts": parts.len(), "counts": counts});
+    std::fs::write(dir.join("meta.json"), meta.to_string()).unwrap();
+    let script = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("benches/coal_motion.py");
+    let out = Command::new(py).arg(&script).arg(&dir).output().unwrap();
+    assert!(out.status.success(), "coal_motion.py: {}", String::from_utf8_lossy(&out.stderr));
+    let coal: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("coal_motion.json")).unwrap()).unwrap();
+    let hits: Vec<bool> = coal["hits"].as_array().unwrap().iter().map(|h| h.as_u64() == Some(1)).collect();
+    let coal_seconds = coal["seconds"].as_f64().unwrap();
+    let m = states.len();
+    let missed = hits.iter().zip(verdicts).filter(|(coal_hit, ours_hit)| !**coal_hit && **ours_hit).count();
+    println!(
+        "| coal, MoveIt-style validation ({:.0} states per trajectory on average, stopping at the first colliding one) | {:.2} ms per trajectory ({} calls to collide; {} of {m} in collision) |",
+        counts.iter().sum::<usize>() as f64 / m as f64,
+        coal_seconds / m as f64 * 1e3,
+        coal["calls"],
+        hits.iter().filter(|h| **h).count()
+    );
+    println!("| **coal MoveIt-style / ours** | **{:.2}** |", coal_seconds / ours);
+    println!("| trajectories MoveIt-style validation passes that ours finds colliding when executed | {missed} of {m} |");
 }

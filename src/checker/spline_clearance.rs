@@ -24,13 +24,15 @@ const MAX_CLEARANCE_STRETCHES: usize = 1 << 16;
 impl Checker {
     /// Per checked link within `clearance_threshold` of the environment somewhere on the segment:
     /// its smallest clearance over the segment (see the module documentation), in link order;
-    /// empty when the threshold is 0. An error when the segment cannot be posed or needs more
-    /// than [`MAX_CLEARANCE_STRETCHES`] stretches.
-    pub fn spline_clearances(&self, segment: &SplineSegment) -> Result<Vec<ReportClearance>, String> {
+    /// empty when the threshold is 0; and the stretches examined. An error when the segment
+    /// cannot be posed or needs more than `budget` (at most [`MAX_CLEARANCE_STRETCHES`])
+    /// stretches.
+    pub fn spline_clearances(&self, segment: &SplineSegment, budget: usize) -> Result<(Vec<ReportClearance>, usize), String> {
         let threshold = self.params().clearance_threshold;
         if !(threshold > 0.0) {
-            return Ok(Vec::new());
+            return Ok((Vec::new(), 0));
         }
+        let budget = budget.min(MAX_CLEARANCE_STRETCHES);
         let path = self.spline_path(segment)?;
         let targets = self.targets().len();
         // Per target: the nearest clearance seen (its report), and the least lower bound over
@@ -41,8 +43,8 @@ impl Checker {
         let mut examined = 0usize;
         while let Some((a, b)) = stack.pop() {
             examined += 1;
-            if examined > MAX_CLEARANCE_STRETCHES {
-                return Err(format!("the path clearance needs more than {MAX_CLEARANCE_STRETCHES} stretches; not given"));
+            if examined > budget {
+                return Err(format!("the path clearance needs more than the {budget} stretches left to it; not given"));
             }
             let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
             let poses = path.link_poses(mid)?;
@@ -74,7 +76,7 @@ impl Checker {
                 lower.iter_mut().zip(&bounds).for_each(|(l, lb)| *l = l.min(*lb));
             }
         }
-        Ok(seen
+        let found = seen
             .into_iter()
             .zip(lower)
             .enumerate()
@@ -91,6 +93,7 @@ impl Checker {
                 c.distance = l;
                 c
             })
-            .collect())
+            .collect();
+        Ok((found, examined))
     }
 }

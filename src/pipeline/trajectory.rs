@@ -217,16 +217,21 @@ impl TrajectoryJob {
     }
 }
 
-/// The smallest clearance of each link over the segments walked so far.
+/// The smallest clearance of each link over the segments walked so far, and the stretches that
+/// cost (one request's clearances share [`MAX_TRAJECTORY_SUBINTERVALS`], as its motion checks do).
 #[derive(Default)]
 struct PathClearance {
     nearest: Vec<crate::checker::ReportClearance>,
+    spent: u64,
 }
 
 impl PathClearance {
     /// Folds in one segment's (nothing when `clearance_threshold` is 0).
     fn add(&mut self, checker: &Checker, segment: &crate::checker::SplineSegment) -> Result<(), String> {
-        for c in checker.spline_clearances(segment)? {
+        let budget = MAX_TRAJECTORY_SUBINTERVALS.saturating_sub(self.spent) as usize;
+        let (found, examined) = checker.spline_clearances(segment, budget)?;
+        self.spent += examined as u64;
+        for c in found {
             match self.nearest.iter_mut().find(|n| n.link_name == c.link_name) {
                 Some(n) if c.distance < n.distance => *n = c,
                 Some(_) => {}
