@@ -112,9 +112,7 @@ impl SplinePath<'_> {
             plain
         }
     }
-}
 
-impl SplinePath<'_> {
     /// The first-order bound of [`MotionPath::bound`], without the tolerance's share.
     fn first_order(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
         let robot = self.checker.robot();

@@ -11,7 +11,7 @@ use super::output_error::OutputError;
 use super::replay_error::ReplayError;
 use super::replay_observer::{FirstWarnings, ReplayObserver};
 use super::replay_summary::{InputCount, ReplaySummary};
-use super::replay_trajectories::Trajectories;
+use super::replay_trajectories::{Trajectories, TRAJECTORY_TYPE};
 use super::timeline::Timeline;
 use super::timeline_svg::timeline_svg;
 use crate::model::{Params, PoseSource};
@@ -191,7 +191,13 @@ impl<'a> Replayer<'a> {
         } else {
             Pipeline::new(params)?
         };
-        let trajectories = opts.trajectory_topic.as_deref().map(|t| Trajectories::open(&bag, t, &opts.bag)).transpose()?;
+        let trajectories = match opts.trajectory_topic.as_deref() {
+            Some(t) => {
+                topic_in_bag(&bag, t, TRAJECTORY_TYPE, "--trajectory-topic", &opts.bag)?;
+                Some(Trajectories::new(t))
+            }
+            None => None,
+        };
         let out = Outputs::create(opts, &bag, &pipeline, pose_source)?;
         let replayer = Replayer {
             opts,
@@ -333,23 +339,28 @@ impl<'a> Replayer<'a> {
 /// The type `pose_source` reads on `topic`, after checking the bag has the topic with that type
 /// and in CDR.
 fn input_type(bag: &BagReader, topic: &str, pose_source: PoseSource, path: &Path) -> Result<&'static str, ReplayError> {
+    let (expected, source_name) = match pose_source {
+        PoseSource::JointStates => ("sensor_msgs/msg/JointState", "joint_states"),
+        PoseSource::Tf => ("tf2_msgs/msg/TFMessage", "tf"),
+    };
+    topic_in_bag(bag, topic, expected, source_name, path)?;
+    Ok(expected)
+}
+
+/// Checks that the bag has `topic` with type `expected` (what `source_name` reads) in CDR.
+fn topic_in_bag(bag: &BagReader, topic: &str, expected: &'static str, source_name: &'static str, path: &Path) -> Result<(), ReplayError> {
     if !bag.topics().iter().any(|(t, _)| *t == topic) {
         let have: Vec<&str> = bag.topics().iter().map(|(t, _)| t.as_str()).collect();
         return Err(ReplayError::MissingTopic { topic: topic.to_owned(), bag: path.to_owned(), have: crate::limits::name_list(&have) });
     }
-    let expected = match pose_source {
-        PoseSource::JointStates => "sensor_msgs/msg/JointState",
-        PoseSource::Tf => "tf2_msgs/msg/TFMessage",
-    };
     if let Some((_, ty)) = bag.topics().iter().find(|(t, ty)| *t == topic && !ty.is_empty() && ty != expected) {
-        let source_name = if pose_source == PoseSource::Tf { "tf" } else { "joint_states" };
         return Err(ReplayError::WrongType { topic: topic.to_owned(), bag: path.to_owned(), found: ty.clone(), source_name, expected });
     }
     // Every message would be undecodable: say why once, up front.
     if let Some((_, encoding)) = bag.encodings().iter().find(|(t, e)| *t == topic && e != "cdr") {
         return Err(ReplayError::Encoding { topic: topic.to_owned(), bag: path.to_owned(), encoding: encoding.clone() });
     }
-    Ok(expected)
+    Ok(())
 }
 
 /// The decoder's complaint about a payload, for the refusal.

@@ -3,13 +3,10 @@
 //! when it was recorded, preempted by the next (`pipeline::TrajectoryStream`); one JSON line per
 //! trajectory in `--jsonl`, counted in the summary.
 
-use super::bag_reader::BagReader;
-use super::replay_error::ReplayError;
 use crate::pipeline::{Pipeline, StreamedTrajectory, TrajectoryStream};
-use std::path::Path;
 
 /// The type a trajectory topic must have.
-const TRAJECTORY_TYPE: &str = "trajectory_msgs/msg/JointTrajectory";
+pub(super) const TRAJECTORY_TYPE: &str = "trajectory_msgs/msg/JointTrajectory";
 
 /// The trajectory topic being replayed.
 #[derive(Debug)]
@@ -19,25 +16,9 @@ pub(super) struct Trajectories {
 }
 
 impl Trajectories {
-    /// Checks that the bag has `topic` as CDR `JointTrajectory` messages.
-    pub(super) fn open(bag: &BagReader, topic: &str, path: &Path) -> Result<Trajectories, ReplayError> {
-        if !bag.topics().iter().any(|(t, _)| *t == topic) {
-            let have: Vec<&str> = bag.topics().iter().map(|(t, _)| t.as_str()).collect();
-            return Err(ReplayError::MissingTopic { topic: topic.to_owned(), bag: path.to_owned(), have: crate::limits::name_list(&have) });
-        }
-        if let Some((_, ty)) = bag.topics().iter().find(|(t, ty)| *t == topic && !ty.is_empty() && ty != TRAJECTORY_TYPE) {
-            return Err(ReplayError::WrongType {
-                topic: topic.to_owned(),
-                bag: path.to_owned(),
-                found: ty.clone(),
-                source_name: "--trajectory-topic",
-                expected: TRAJECTORY_TYPE,
-            });
-        }
-        if let Some((_, encoding)) = bag.encodings().iter().find(|(t, e)| *t == topic && e != "cdr") {
-            return Err(ReplayError::Encoding { topic: topic.to_owned(), bag: path.to_owned(), encoding: encoding.clone() });
-        }
-        Ok(Trajectories { topic: topic.to_owned(), stream: TrajectoryStream::default() })
+    /// The trajectories of `topic` (the bag was checked to have it: `replay_run::topic_in_bag`).
+    pub(super) fn new(topic: &str) -> Trajectories {
+        Trajectories { topic: topic.to_owned(), stream: TrajectoryStream::default() }
     }
 
     /// A trajectory recorded at `log_time`: the answer for the one it preempts.
