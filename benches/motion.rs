@@ -2,6 +2,7 @@
 //! planner-like motions (each arm joint moves 0.1–1 rad), one core, load time excluded.
 //!
 //!   cargo bench --bench motion            # MOTIONS=10000 DENSE=100 COAL=1000 by default
+//!   WORLD=wall cargo bench --bench motion # one wavy 1M-triangle wall facing the arm instead
 //!
 //! Prints a markdown table: the mean time per motion of `check_motion` beside the mean time per
 //! state of the discrete check on the motions' end states (timed in turn, motion then state, so
@@ -17,6 +18,8 @@
 
 #[path = "peer_compare_core.rs"]
 mod peer_compare_core;
+#[path = "wall_1m.rs"]
+mod wall_1m;
 
 use oorandom::Rand64;
 use std::path::{Path, PathBuf};
@@ -45,7 +48,7 @@ fn main() {
     let coal_motions = env_usize("COAL", 1_000).min(motions);
     let py = peer_compare_core::python();
     let (robot, map) = peer_compare_core::panda(&py);
-    let world = peer_compare_core::world(1_000_000);
+    let world = bench_world();
     let cells = world.scene.cell_count();
     let (world_vertices, world_triangles) = (world.vertices, world.triangles);
     let params = Params { package_map: map.clone(), ..Params::default() };
@@ -97,7 +100,7 @@ fn main() {
     let motion_mean = motion_seconds / motions as f64;
     let state_mean = state_seconds / motions as f64;
 
-    println!("Panda, {cells} cells (1M triangles), one core, motion_tolerance {tol} m; {motions} motions, each arm joint 0.1-1 rad:\n");
+    println!("Panda, {cells} cells (1M triangles, {}), one core, motion_tolerance {tol} m; {motions} motions, each arm joint 0.1-1 rad:\n", world_name());
     println!("| measure | value |");
     println!("|---|---|");
     println!(
@@ -112,7 +115,7 @@ fn main() {
     // by `tol / 2` (padding: faces out by exactly that), each sample a flags-only check.
     if dense > 0 {
         let grown_params = Params { package_map: map.clone(), padding: Padding { links: vec!["*".into()], values: vec![tol / 2.0] }, ..Params::default() };
-        let grown = Checker::from_robot_and_scene(grown_params, robot.clone(), peer_compare_core::world(1_000_000).scene, "panda, grown".into()).unwrap();
+        let grown = Checker::from_robot_and_scene(grown_params, robot.clone(), bench_world().scene, "panda, grown".into()).unwrap();
         let (mut dense_seconds, mut ours_seconds, mut samples, mut sampled_colliding, mut disagree) = (0.0, 0.0, 0usize, 0usize, 0usize);
         for (q0, q1) in pairs.iter().take(dense) {
             let n = dense_steps(q0, q1);
@@ -150,6 +153,29 @@ fn main() {
 
     if coal_motions > 0 {
         coal_moveit(&py, &checker, &pairs[..coal_motions], &reports[..coal_motions], &world_vertices, &world_triangles, &names, &along, &dense_steps);
+    }
+}
+
+/// `WORLD`: `peer` (default) or `wall`.
+fn world_name() -> String {
+    std::env::var("WORLD").unwrap_or_else(|_| "peer".into())
+}
+
+/// The peer benchmark's world (a guard, a scanned wall and a shelf), or one wavy 7 x 7 m wall of
+/// 1M triangles standing 0.5 m in front of the arm's base, its front towards the arm (local x
+/// along world -y, local y up, local z towards -x), from 1 m below the base.
+fn bench_world() -> peer_compare_core::World {
+    match world_name().as_str() {
+        "wall" => {
+            use thickness_collision::math::Rotation;
+            let pose = Pose::from_parts(
+                Vector::new(0.5, 3.5, -1.0),
+                Rotation::from_rotation_z(-std::f64::consts::FRAC_PI_2) * Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2),
+            );
+            peer_compare_core::world_from(vec![("wavy_wall".into(), wall_1m::wall(708, 708), pose)])
+        }
+        "peer" => peer_compare_core::world(1_000_000),
+        other => panic!("WORLD={other}: `peer` or `wall`"),
     }
 }
 

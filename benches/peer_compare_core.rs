@@ -69,11 +69,16 @@ pub struct World {
 }
 
 pub fn world(triangles: usize) -> World {
+    world_from(peer_environment(triangles))
+}
+
+/// A world of thin surfaces, each with cells of `THICKNESS` behind it.
+pub fn world_from(surfaces: Vec<(String, thickness_collision::mesh::generate::Soup, Pose)>) -> World {
     let mut scene = Scene::new();
     let mut vertices = Vec::new();
     let mut tris = Vec::new();
     let started = Instant::now();
-    for (name, (v, t), pose) in peer_environment(triangles) {
+    for (name, (v, t), pose) in surfaces {
         let area = scaffold::thin_area(&v, &t, THICKNESS);
         let _ = scene.add_surface(name, pose, area);
         let base = vertices.len() as u32;

@@ -87,6 +87,20 @@ fn motions_agree_with_dense_sampling() {
         }
         colliding += 1;
         let f = r.fraction.unwrap();
+        // The report checks only what blocked the motion there: a full check of that state finds
+        // exactly its contacts (every other link and pair was cleared around it), the motion's
+        // report adding at most the near miss of the link that blocked it (depth 0).
+        let full = c.check_positions(&at(f)).unwrap();
+        let key = |x: &thickness_collision::checker::ReportContact| (x.link_name.clone(), x.object_name.clone(), x.triangle, x.depth.to_bits());
+        let mut extra: Vec<_> = r.report.contacts.iter().filter(|x| !full.contacts.iter().any(|y| key(x) == key(y))).collect();
+        assert!(
+            full.contacts.iter().all(|y| r.report.contacts.iter().any(|x| key(x) == key(y))),
+            "motion {m}: the state at {f} has {:?}, the motion reports {:?}",
+            full.contacts,
+            r.report.contacts
+        );
+        assert!(extra.len() <= 1 && extra.pop().is_none_or(|x| x.depth == 0.0), "motion {m}: {:?} beyond the state's {:?}", r.report.contacts, full.contacts);
+        assert_eq!(r.report.out_of_limits, full.out_of_limits);
         if first_hit.is_some_and(|s| s <= f + 2.0 / n as f64) {
             continue;
         }

@@ -60,9 +60,60 @@ pub(super) fn point_acceleration(robot: &RobotModel, levers: &[(usize, Real)], d
     total
 }
 
+/// What the joints below a target do to it at the middle of a stretch (see `JointPath::bound`).
+struct Moved {
+    /// `Σ_j |Δq_j| · lever_j`, each lever tightened at the middle.
+    levers: Real,
+    /// The link's angular velocity, and the velocity of the point given.
+    omega: Vector,
+    velocity: Vector,
+    /// Every joint that moves was posed (else only the lever sum holds).
+    first_order: bool,
+}
+
 impl JointPath<'_> {
     fn at(&self, s: f64) -> Vec<f64> {
         self.q0.iter().zip(&self.delta).map(|(a, d)| a + s * d).collect()
+    }
+
+    /// Target `ti`'s joints, nearest first, up to the first that `shared` names (the joints above
+    /// it move the other target of a pair too, and so the pair as one body): the lever sum, each
+    /// lever the smaller of its bound over all configurations and the distance from the axis to
+    /// the link's origin at the middle, plus the link's reach, plus what the joints between can
+    /// change that within `half`; and the velocities at the middle, of the link's rotation and
+    /// of the point `c`.
+    fn levers_at(&self, ti: usize, link: Pose, c: Vector, poses: &[Option<Pose>], half: f64, shared: impl Fn(usize) -> bool) -> Moved {
+        let robot = self.checker.robot();
+        let bounds = self.checker.motion_bounds();
+        let reach = bounds.reach[ti];
+        // Σ_i |Δq_i| r_ik over the joints between the current one and the link.
+        let mut below = 0.0;
+        let mut moved = Moved { levers: 0.0, omega: Vector::ZERO, velocity: Vector::ZERO, first_order: true };
+        for &(j, r) in bounds.levers[ti].iter().take_while(|(j, _)| !shared(*j)) {
+            let d = self.delta[j].abs();
+            let joint = &robot.joints[j];
+            let lever = match (joint.kind, poses[joint.child]) {
+                (JointKind::Revolute | JointKind::Continuous, Some(child)) => {
+                    let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
+                    let rel = link.translation - child.translation;
+                    let off_axis = (rel - axis * rel.dot(axis)).length();
+                    moved.omega += axis * self.delta[j];
+                    moved.velocity += axis.cross(c - child.translation) * self.delta[j];
+                    r.min(off_axis + reach + half * below)
+                }
+                (JointKind::Prismatic, Some(child)) => {
+                    moved.velocity += child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z) * self.delta[j];
+                    r
+                }
+                _ => {
+                    moved.first_order &= d == 0.0;
+                    r
+                }
+            };
+            moved.levers += d * lever;
+            below += d * r;
+        }
+        moved
     }
 }
 
@@ -88,47 +139,14 @@ impl MotionPath for JointPath<'_> {
     /// most `half · (|v_c| + |ω| R) + half² · A / 2` from where it is at `s`, with `A` the
     /// acceleration bound of `point_acceleration`. The smaller of the two bounds is used.
     fn bound(&self, ti: usize, poses: &[Option<Pose>], _mid: f64, half: f64) -> Real {
-        let robot = self.checker.robot();
-        let bounds = self.checker.motion_bounds();
         let Some(link) = poses[self.checker.targets()[ti].link] else { return half * self.speeds[ti] };
-        let reach = bounds.reach[ti];
-        let (centre, radius) = bounds.ball[ti];
-        let c = link * centre;
-        // Σ_i |Δq_i| r_ik over the joints between the current one and the link.
-        let mut below = 0.0;
-        let mut total = 0.0;
-        // The link's angular velocity and the velocity of `c`, at `s`.
-        let (mut omega, mut velocity) = (Vector::ZERO, Vector::ZERO);
-        let mut first_order = true;
-        for &(j, r) in &bounds.levers[ti] {
-            let d = self.delta[j].abs();
-            let joint = &robot.joints[j];
-            let lever = match (joint.kind, poses[joint.child]) {
-                (JointKind::Revolute | JointKind::Continuous, Some(child)) => {
-                    let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
-                    let rel = link.translation - child.translation;
-                    let off_axis = (rel - axis * rel.dot(axis)).length();
-                    omega += axis * self.delta[j];
-                    velocity += axis.cross(c - child.translation) * self.delta[j];
-                    r.min(off_axis + reach + half * below)
-                }
-                (JointKind::Prismatic, Some(child)) => {
-                    velocity += child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z) * self.delta[j];
-                    r
-                }
-                _ => {
-                    first_order &= d == 0.0;
-                    r
-                }
-            };
-            total += d * lever;
-            below += d * r;
-        }
-        let levers = half * total;
-        if !first_order {
+        let (centre, radius) = self.checker.motion_bounds().ball[ti];
+        let moved = self.levers_at(ti, link, link * centre, poses, half, |_| false);
+        let levers = half * moved.levers;
+        if !moved.first_order {
             return levers;
         }
-        let moving = half * (velocity.length() + omega.length() * radius) + 0.5 * half * half * self.accelerations[ti];
+        let moving = half * (moved.velocity.length() + moved.omega.length() * radius) + 0.5 * half * half * self.accelerations[ti];
         // NaN (a bad pose) falls back to the lever bound.
         if moving < levers {
             moving
@@ -137,15 +155,29 @@ impl MotionPath for JointPath<'_> {
         }
     }
 
+    fn out_of_limits(&self, s: f64) -> Vec<String> {
+        self.checker.out_of_limits(&self.at(s))
+    }
+
     fn report_at(&self, s: f64) -> StateReport {
         self.checker.check_positions(&self.at(s)).unwrap_or_else(|e| StateReport::failed(e.to_string()))
     }
 
     /// In the frame of the last link upstream of both: only the joints that move one of the two
-    /// and not the other count (a joint above both turns the pair as one body). Each with its
-    /// lever bound over all configurations; the world bounds when those are smaller in sum.
+    /// and not the other count (a joint above both turns the pair as one body), each lever
+    /// tightened at the middle as for `bound`; the world bounds when those are smaller in sum.
     fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> (Real, Real) {
-        let relative = self.pair_bound_quick(a, b, poses, mid, half);
+        let targets = self.checker.targets();
+        let relative = match (poses[targets[a].link], poses[targets[b].link]) {
+            (Some(pa), Some(pb)) => {
+                let levers = &self.checker.motion_bounds().levers;
+                let own = |x: usize, y: usize, pose: Pose| {
+                    half * self.levers_at(x, pose, pose.translation, poses, half, |j| levers[y].iter().any(|(k, _)| *k == j)).levers
+                };
+                (own(a, b, pa), own(b, a, pb))
+            }
+            _ => self.pair_bound_quick(a, b, poses, mid, half),
+        };
         let world = (self.bound(a, poses, mid, half), self.bound(b, poses, mid, half));
         if relative.0 + relative.1 <= world.0 + world.1 {
             relative

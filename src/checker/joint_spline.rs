@@ -175,6 +175,10 @@ impl MotionPath for SplinePath<'_> {
         }
     }
 
+    fn out_of_limits(&self, s: f64) -> Vec<String> {
+        self.checker.out_of_limits(&self.segment.at(s))
+    }
+
     fn report_at(&self, s: f64) -> StateReport {
         self.checker.check_positions(&self.segment.at(s)).unwrap_or_else(|e| StateReport::failed(e.to_string()))
     }

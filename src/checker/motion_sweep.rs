@@ -52,6 +52,10 @@ pub(super) trait MotionPath {
     }
     /// The report of the state at `s` (its contacts are those of a motion found colliding there).
     fn report_at(&self, s: f64) -> StateReport;
+    /// The joints out of their limits at `s` (none for a motion between link poses).
+    fn out_of_limits(&self, _s: f64) -> Vec<String> {
+        Vec::new()
+    }
     /// The part of target `ti`'s bounds that does not shrink with the stretch (a path tolerance:
     /// every configuration within it of the path is covered). A stretch whose bound is within
     /// the ladder's first rung of it cannot be narrowed further.
@@ -217,13 +221,31 @@ impl Checker {
                 MotionReport { report: StateReport { motion: true, clearances, ..Default::default() }, fraction: None, subintervals: examined }
             }
             Some(b) => {
-                let report = path.report_at(b.fraction);
+                let report = self.report_where_blocked(path, &b);
                 let report = match b.other {
                     None => self.motion_contact(report, &b.grown),
                     Some(other) => self.motion_self_contact(report, &b.grown, &other),
                 };
                 blocked_report(report, b.fraction, examined)
             }
+        }
+    }
+
+    /// The report of the state where the motion is blocked: only the blocked target or pair is
+    /// checked there (every other was cleared over stretches covering that state), unless the
+    /// motion is blocked at its start (the targets and pairs after the blocked one were then not
+    /// examined at all) or clearances are asked for (they need every link).
+    fn report_where_blocked(&self, path: &impl MotionPath, b: &Blocked) -> StateReport {
+        if self.params().clearance_threshold > 0.0 || b.fraction <= 0.0 {
+            return path.report_at(b.fraction);
+        }
+        match path.link_poses(b.fraction) {
+            Ok(poses) => {
+                let mut report = self.blocked_state_report(&poses, b.grown.ti, b.other.map(|o| o.ti));
+                report.out_of_limits = path.out_of_limits(b.fraction);
+                report
+            }
+            Err(e) => StateReport::failed(e),
         }
     }
 
@@ -234,6 +256,12 @@ impl Checker {
         // A link that does not move is where it is at every s: checked as it is, ungrown (a
         // base resting on a table is not a near miss).
         let delta = if path.speeds()[ti] > 0.0 { path.bound(ti, poses, start + half, half) } else { 0.0 };
+        // A ball around the link, grown by the bound, apart from every box near it: clear at any
+        // growth, without a walk of the cells.
+        let (centre, radius) = self.motion_bounds().ball[ti];
+        if self.scene().ball_is_clear(pose * centre, radius + delta, |oi| !self.allowed[ti][oi]) {
+            return Ok(Stretch::Clear);
+        }
         let grown = grown_for(self.motion_bounds(), ti, pose, delta, path.floor(ti));
         let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
         Ok(Stretch::judge(start, grown, None, || self.grown_link_hit(&grown, &flags)))

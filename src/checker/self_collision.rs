@@ -153,22 +153,22 @@ impl Checker {
     /// link in model order, `object_name` the other, `normal` pushing `link_name` out, `depth`
     /// the least overlap of its deepest pair of parts.
     pub(crate) fn self_contacts(&self, world: &[Option<Pose>]) -> Vec<ReportContact> {
+        self.self_pairs().pairs.iter().filter_map(|&(a, b)| self.self_pair_contact(world, a, b)).collect()
+    }
+
+    /// The contact of self pair `(a, b)` at `world`, as a report gives it.
+    pub(crate) fn self_pair_contact(&self, world: &[Option<Pose>], a: usize, b: usize) -> Option<ReportContact> {
         let targets = self.targets();
-        let mut out = Vec::new();
-        for &(a, b) in &self.self_pairs().pairs {
-            if let Some(c) = pair_contact(targets, world, a, b) {
-                out.push(ReportContact {
-                    link_name: targets[a].name.clone(),
-                    object_name: targets[b].name.clone(),
-                    triangle: u32::MAX,
-                    depth: c.depth,
-                    position: Some(c.position.to_array()),
-                    normal: c.normal.to_array(),
-                    object_type: self.target_kind(b),
-                    link_type: self.target_kind(a),
-                });
-            }
-        }
-        out
+        let c = pair_contact(targets, world, a, b)?;
+        Some(ReportContact {
+            link_name: targets[a].name.clone(),
+            object_name: targets[b].name.clone(),
+            triangle: u32::MAX,
+            depth: c.depth,
+            position: Some(c.position.to_array()),
+            normal: c.normal.to_array(),
+            object_type: self.target_kind(b),
+            link_type: self.target_kind(a),
+        })
     }
 }

@@ -56,16 +56,51 @@ impl Checker {
         let poses = self.robot.forward_kinematics(q, &self.base)?;
         let world: Vec<Option<Pose>> = poses.iter().map(|p| Some(pose_from_isometry(p))).collect();
         let mut report = self.check_link_poses(&world, settings);
-        report.out_of_limits = self
-            .robot
+        report.out_of_limits = self.out_of_limits(q);
+        report.check_seconds = started.elapsed().as_secs_f64();
+        Ok(report)
+    }
+
+    /// The revolute and prismatic joints of `q` outside their limits, by name.
+    pub(super) fn out_of_limits(&self, q: &[f64]) -> Vec<String> {
+        self.robot
             .joints
             .iter()
             .zip(q)
             .filter(|(j, v)| matches!(j.kind, JointKind::Revolute | JointKind::Prismatic) && (**v < j.limits[0] - 1e-12 || **v > j.limits[1] + 1e-12))
             .map(|(j, _)| j.name.clone())
-            .collect();
-        report.check_seconds = started.elapsed().as_secs_f64();
-        Ok(report)
+            .collect()
+    }
+
+    /// The report of the state at `world` as [`Checker::check_link_poses`] gives it, when only
+    /// target `ti` against the environment (or, with `other`, self pair `(ti, other)`) can
+    /// collide there: a motion blocked at a stretch has cleared every other target and pair over
+    /// stretches that cover the stretch's start. No clearances (a report with them is a full
+    /// check).
+    pub(super) fn blocked_state_report(&self, world: &[Option<Pose>], ti: usize, other: Option<usize>) -> StateReport {
+        let mut report = StateReport::default();
+        let contact = match (other, world[self.targets[ti].link]) {
+            (None, Some(pose)) => self.link_contact(ti, pose, &CHECK_SETTINGS).map(|c| self.environment_contact(ti, &c)),
+            (Some(tb), _) => self.self_pair_contact(world, ti, tb),
+            (None, None) => None,
+        };
+        report.contacts.extend(contact);
+        report.in_collision = !report.contacts.is_empty();
+        report
+    }
+
+    /// A link's contact with the environment as a report gives it.
+    fn environment_contact(&self, ti: usize, c: &Contact) -> ReportContact {
+        ReportContact {
+            link_name: self.targets[ti].name.clone(),
+            object_name: self.scene.objects()[c.object].name.clone(),
+            triangle: self.scene.reported_triangle(c.object, c.triangle),
+            depth: c.depth,
+            position: c.position.map(|p| p.to_array()),
+            normal: c.normal.to_array(),
+            object_type: ObjectType::Environment,
+            link_type: self.target_kind(ti),
+        }
     }
 
     /// Checks the links at given world poses (indexed like `robot().links`). Every checked link
@@ -102,16 +137,7 @@ impl Checker {
                 report.clearances.extend(link_clearance(&self.scene, &self.allowed[ti], lt, link_pose, best.as_ref(), threshold));
             }
             if let Some(c) = best {
-                report.contacts.push(ReportContact {
-                    link_name: lt.name.clone(),
-                    object_name: self.scene.objects()[c.object].name.clone(),
-                    triangle: self.scene.reported_triangle(c.object, c.triangle),
-                    depth: c.depth,
-                    position: c.position.map(|p| p.to_array()),
-                    normal: c.normal.to_array(),
-                    object_type: ObjectType::Environment,
-                    link_type: self.target_kind(ti),
-                });
+                report.contacts.push(self.environment_contact(ti, &c));
             }
         }
         // Every colliding self pair, in flag-only checks too (which links collide must not

@@ -29,6 +29,7 @@ mod polytope;
 mod report;
 mod sat;
 mod scene;
+mod scene_ball;
 mod scene_clearance;
 mod target;
 mod target_view;

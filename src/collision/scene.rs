@@ -44,7 +44,7 @@ pub struct SceneObject {
     /// Its geometry (shared: a planning-scene object that moves keeps its cells).
     pub body: Arc<ObjectBody>,
     /// Its bounding box in the world (a first, cheap reject per target).
-    world_aabb: Aabb,
+    pub(super) world_aabb: Aabb,
     /// Added to its cells' triangle indices in reports: a planning-scene object's meshes count
     /// their triangles on from the meshes before them (0 for the environment's).
     pub(crate) triangle_base: u32,
