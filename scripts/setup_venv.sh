@@ -26,6 +26,9 @@ packages=(
     "xacro==2.1.1"              # ROS's xacro, to expand MoveIt's .xacro configs as users do
     "zstandard==0.25.0"         # zstd bindings: compresses bags as rosbag2 does (tests/replay_compressed.rs)
     "ruckig==0.19.4"            # jerk-limited time parameterisation (benches/trajectory.rs's trajectories)
+    "maturin==1.16.0"           # builds the Python package (python/) into this venv (tests/python_package.rs)
+    "pytest==9.2.0"             # runs the Python package's tests
+    "ompl==2.0.1"               # OMPL's own wheel (nanobind): the package's validators (python/tests/test_ompl.py)
 )
 stamp="$venv/.tc-packages"
 want="$("$python" -c 'import sys; print(sys.version.split()[0])') ${packages[*]}"
@@ -52,12 +55,12 @@ else
     # its metadata and its share folder).
     "$venv/bin/python" - >&2 <<'EOF'
 import importlib.metadata as md, os, site
-import coal, fcl, numpy, rosbags, cyclonedds, mcap_ros2, yourdfpy, xacro, zstandard
+import coal, fcl, numpy, rosbags, cyclonedds, mcap_ros2, yourdfpy, xacro, zstandard, ruckig, maturin, pytest, ompl.base
 share = [os.path.join(p, "cmeel.prefix", "share", "example-robot-data") for p in site.getsitepackages()]
 assert any(os.path.isdir(s) for s in share), f"example-robot-data share folder missing: {share}"
 print("setup_venv: " + ", ".join(f"{p} {md.version(p)}" for p in [
     "numpy", "coal", "python-fcl", "rosbags", "cyclonedds", "example-robot-data",
-    "mcap-ros2-support", "yourdfpy", "xacro", "zstandard"]))
+    "mcap-ros2-support", "yourdfpy", "xacro", "zstandard", "ruckig", "maturin", "pytest", "ompl"]))
 EOF
     echo "$want" > "$stamp"
     echo "setup_venv: installed into $venv in $(( $(date +%s) - start )) s" >&2

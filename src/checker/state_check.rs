@@ -23,6 +23,13 @@ impl Checker {
         self.check_positions(&q)
     }
 
+    /// Positions for every joint of the model (indexed like `robot().joints`) from a named state,
+    /// as [`Checker::check_joints`] resolves them: mimic joints from their master, a joint the
+    /// state lacks at 0 (an error under `missing_joint: reject`).
+    pub fn positions(&self, names: &[String], positions: &[f64]) -> Result<Vec<f64>, StateError> {
+        resolve_positions(&self.robot, names, positions, self.params.missing_joint)
+    }
+
     /// Which links collide, and nothing more: each link stops at its first colliding cell, and
     /// its contact carries only link and object names (no depth, point or normal). The
     /// like-for-like counterpart of a boolean `collide` in FCL or coal.

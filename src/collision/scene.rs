@@ -68,6 +68,15 @@ impl SceneObject {
     }
 }
 
+/// The world box of `body` placed at `pose` (invalid for a surface without cells).
+fn world_box(body: &ObjectBody, pose: &Pose) -> Aabb {
+    match body {
+        ObjectBody::Surface { tree, .. } if tree.is_empty() => Aabb::new_invalid(),
+        ObjectBody::Surface { tree, .. } => transformed_box(&tree.root_aabb(), pose),
+        ObjectBody::Solid(shape) => transformed_box(&shape.local_aabb(), pose),
+    }
+}
+
 /// Environment objects and the queries of convex targets against them.
 // Objects are shared, so that a scene of the same environment with other planning-scene objects
 // is made without copying any cells.
@@ -97,13 +106,24 @@ impl Scene {
     /// Adds a body built before (perhaps placed elsewhere in another scene) at `pose`. Returns
     /// the object's index.
     pub(crate) fn add_body(&mut self, name: impl Into<String>, pose: Pose, body: Arc<ObjectBody>) -> usize {
-        let world_aabb = match &*body {
-            ObjectBody::Surface { tree, .. } if tree.is_empty() => Aabb::new_invalid(),
-            ObjectBody::Surface { tree, .. } => transformed_box(&tree.root_aabb(), &pose),
-            ObjectBody::Solid(shape) => transformed_box(&shape.local_aabb(), &pose),
-        };
+        let world_aabb = world_box(&body, &pose);
         self.objects.push(Arc::new(SceneObject { name: name.into(), pose, body, world_aabb, triangle_base: 0 }));
         self.objects.len() - 1
+    }
+
+    /// Moves object `index` to `pose`, its cells shared, not rebuilt. False when there is no
+    /// such object.
+    pub fn set_pose(&mut self, index: usize, pose: Pose) -> bool {
+        let Some(old) = self.objects.get(index) else { return false };
+        let world_aabb = world_box(&old.body, &pose);
+        let moved = SceneObject { name: old.name.clone(), pose, body: old.body.clone(), world_aabb, triangle_base: old.triangle_base };
+        self.objects[index] = Arc::new(moved);
+        true
+    }
+
+    /// Removes object `index` (the later ones move down by one), returning it.
+    pub fn remove(&mut self, index: usize) -> Option<Arc<SceneObject>> {
+        (index < self.objects.len()).then(|| self.objects.remove(index))
     }
 
     /// [`Scene::add_body`] for a mesh whose triangles are counted from `triangle_base` on.

@@ -18,6 +18,7 @@ mod xacro;
 mod xml_guard;
 
 pub use self::bundled::bundled_config_dir;
+#[cfg(feature = "ros")]
 pub(crate) use self::glob::glob_match;
 pub(crate) use self::mesh_file::scale_mesh;
 #[cfg(feature = "testing")]

@@ -35,6 +35,7 @@ pub use self::state_pipeline::{Pipeline, RobotState};
 // The node's and replay's own steps: `/tf` of a state, and the request jobs the node's workers run
 // (the fuzz harness reaches the jobs through `fuzz_access`).
 pub(crate) use self::link_transforms::link_transforms;
+#[cfg(feature = "ros")]
 pub(crate) use self::scene_input::{BuiltScene, ScenePlan};
 pub(crate) use self::trajectory::TrajectoryJob;
 pub use self::trajectory::{Outcome, APPROACH_SEGMENT};

@@ -4,9 +4,9 @@
 use crate::cdr_records::{cdr_records, CdrKind, CDR_KINDS};
 use crate::fixtures::workcell;
 use std::path::Path;
+use thickness_collision::fuzz_access::{parse_mesh, AttachedCollisionObject, GetStateValidityRequest, JointConstraint, RobotStateMsg};
 use thickness_collision::math::Vector;
 use thickness_collision::model::{bundled_config_dir, Params};
-use thickness_collision::fuzz_access::{parse_mesh, AttachedCollisionObject, GetStateValidityRequest, JointConstraint, RobotStateMsg};
 use thickness_collision::msgs::{
     CheckStatesRequest, CheckTrajectoryRequest, ClockMsg, DurationMsg, Header, JointState, JointTrajectory, JointTrajectoryPoint, Quaternion, StringMsg,
     TfMessage, Time, Transform, TransformStamped, Vector3,

@@ -1,0 +1,229 @@
+//! `Checker`: a robot and its environment, checked from Python. One `Checker` serves many
+//! threads at once (the library's checker is immutable after loading; the class is frozen).
+
+use crate::errors::{error, value_error};
+use crate::positions::{rows, state};
+use crate::report::Report;
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::prelude::*;
+use rayon::prelude::*;
+use std::path::PathBuf;
+use std::sync::Arc;
+use thickness_collision::checker::{Checker as Core, StateError};
+use thickness_collision::model::{InputFiles, JointKind, Params, DEFAULT_NODE_FQN};
+
+/// Per-row flags and fractions of a batch of motions.
+type MotionArrays<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>);
+
+/// A robot among its environment's thin surfaces and solids, as the node checks it.
+#[pyclass(frozen, module = "thickness_collision")]
+pub struct Checker {
+    core: Arc<Core>,
+    /// The actuated joints (not mimic, not fixed), in model order: the order of every array.
+    names: Vec<String>,
+    /// Their indices in the model's joints.
+    index: Vec<usize>,
+}
+
+fn state_error(e: StateError) -> PyErr {
+    value_error(e)
+}
+
+impl Checker {
+    fn from_core(core: Core) -> Checker {
+        let (names, index) = core.robot().joints.iter().enumerate().filter(|(_, j)| j.is_actuated()).map(|(i, j)| (j.name.clone(), i)).unzip();
+        Checker { core: Arc::new(core), names, index }
+    }
+
+    fn build(params: Params) -> PyResult<Checker> {
+        params.validate().map_err(value_error)?;
+        Core::from_params(params).map(Checker::from_core).map_err(error)
+    }
+
+    /// Every joint's position from a row in `joint_names` order.
+    fn full(&self, row: &[f64]) -> Result<Vec<f64>, StateError> {
+        self.core.positions(&self.names, row)
+    }
+}
+
+#[pymethods]
+impl Checker {
+    /// A checker from files: `robot` and `environment` URDFs (`None`: the parameters' or the
+    /// bundled workcell's), an SRDF, a thickness (metres) and side (`"back"`, `"front"`,
+    /// `"both"`) for every thin surface, and a parameters file as the node reads it.
+    #[new]
+    #[pyo3(signature = (robot=None, environment=None, srdf=None, thickness=None, side=None, params=None, clearance_threshold=None))]
+    fn new(
+        robot: Option<PathBuf>,
+        environment: Option<PathBuf>,
+        srdf: Option<PathBuf>,
+        thickness: Option<f64>,
+        side: Option<&str>,
+        params: Option<PathBuf>,
+        clearance_threshold: Option<f64>,
+    ) -> PyResult<Checker> {
+        let mut p = match params {
+            Some(path) => Params::from_files_for_node(&[path], DEFAULT_NODE_FQN).map_err(error)?.params,
+            None => Params::default(),
+        };
+        if let Some(t) = thickness {
+            if !thickness_collision::limits::is_length(t) {
+                let [lo, hi] = thickness_collision::limits::LENGTH_RANGE;
+                return Err(value_error(format!("thickness {t}: must be from {lo:e} to {hi:e} m")));
+            }
+            p.default_thickness = t;
+            p.thin_surfaces.thickness.iter_mut().for_each(|x| *x = t);
+        }
+        if let Some(side) = side {
+            let side: thickness_collision::thickness::Side = side.parse().map_err(value_error)?;
+            p.default_side = side;
+            p.thin_surfaces.side.iter_mut().for_each(|x| *x = side);
+        }
+        if let Some(srdf) = srdf {
+            p.robot_semantic_file = srdf.display().to_string();
+        }
+        if let Some(c) = clearance_threshold {
+            p.clearance_threshold = c;
+        }
+        if robot.is_some() || environment.is_some() {
+            p.input_files = InputFiles { robot, environment };
+        }
+        Checker::build(p)
+    }
+
+    /// A checker from a parameters file, as the node reads it for `/thickness_collision`.
+    #[staticmethod]
+    fn from_params(path: PathBuf) -> PyResult<Checker> {
+        let loaded = Params::from_files_for_node(&[path], DEFAULT_NODE_FQN).map_err(error)?;
+        Checker::build(loaded.params)
+    }
+
+    /// The actuated joints (not mimic, not fixed), in model order.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.names.clone()
+    }
+
+    /// (lower, upper) limits in `joint_names` order; a continuous joint's are -π and π (one
+    /// turn: a planner's bounds).
+    #[getter]
+    fn limits<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>) {
+        let joints = &self.core.robot().joints;
+        let turn = |i: usize| -> [f64; 2] {
+            match joints[i].kind {
+                JointKind::Continuous => [-std::f64::consts::PI, std::f64::consts::PI],
+                _ => joints[i].limits,
+            }
+        };
+        let (lo, hi): (Vec<f64>, Vec<f64>) = self.index.iter().map(|&i| (turn(i)[0], turn(i)[1])).unzip();
+        (lo.into_pyarray(py), hi.into_pyarray(py))
+    }
+
+    /// The report of one state: `q` in `joint_names` order (a sequence or array), or a dict
+    /// of `{name: value}` (a joint it lacks at 0).
+    fn check(&self, py: Python<'_>, q: &Bound<'_, PyAny>) -> PyResult<Report> {
+        let s = state(q, &self.names, "q")?;
+        let report = py.detach(|| self.core.check_joints(&s.names, &s.values)).map_err(state_error)?;
+        Ok(Report::new(report))
+    }
+
+    /// Whether each row of `Q` (`N x dof`, `joint_names` order) collides, on every core with the
+    /// GIL released; with `depths=True` also each state's deepest contact depth (0 when free).
+    #[pyo3(signature = (q, depths=false))]
+    fn check_batch<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>, depths: bool) -> PyResult<Bound<'py, PyAny>> {
+        let rows = rows(q, &self.names, "Q")?;
+        let results: Vec<Result<(bool, f64), StateError>> = py.detach(|| {
+            rows.par_iter()
+                .map(|row| {
+                    if depths {
+                        let r = self.core.check_joints(&self.names, row)?;
+                        Ok((r.in_collision, r.contacts.iter().map(|c| c.depth).fold(0.0, f64::max)))
+                    } else {
+                        Ok((self.core.check_joints_flags(&self.names, row)?.in_collision, 0.0))
+                    }
+                })
+                .collect()
+        });
+        let results: Vec<(bool, f64)> = results.into_iter().collect::<Result<_, _>>().map_err(state_error)?;
+        let (flags, deep): (Vec<bool>, Vec<f64>) = results.into_iter().unzip();
+        let flags = flags.into_pyarray(py).into_any();
+        if depths {
+            Ok((flags, deep.into_pyarray(py)).into_pyobject(py)?.into_any())
+        } else {
+            Ok(flags)
+        }
+    }
+
+    /// The guaranteed check of the straight line in joint space from `q0` to `q1`: "free" is
+    /// certain; in collision, `fraction` is no later than the first contact.
+    fn check_motion(&self, py: Python<'_>, q0: &Bound<'_, PyAny>, q1: &Bound<'_, PyAny>) -> PyResult<Report> {
+        let (a, b) = (state(q0, &self.names, "q0")?, state(q1, &self.names, "q1")?);
+        let from = self.core.positions(&a.names, &a.values).map_err(state_error)?;
+        let to = self.core.positions(&b.names, &b.values).map_err(state_error)?;
+        Ok(Report::new(py.detach(|| self.core.check_motion(&from, &to).report)))
+    }
+
+    /// The motions along a path (rows of `Q`), one report per edge, in order; the first edge in
+    /// collision ends it (the reports stop there).
+    fn check_path(&self, py: Python<'_>, q: &Bound<'_, PyAny>) -> PyResult<Vec<Report>> {
+        let rows = rows(q, &self.names, "Q")?;
+        let full: Vec<Vec<f64>> = rows.iter().map(|r| self.full(r)).collect::<Result<_, _>>().map_err(state_error)?;
+        let reports = py.detach(|| {
+            let mut out = Vec::with_capacity(full.len().saturating_sub(1));
+            for edge in full.windows(2) {
+                let r = self.core.check_motion(&edge[0], &edge[1]).report;
+                let stop = r.in_collision;
+                out.push(r);
+                if stop {
+                    break;
+                }
+            }
+            out
+        });
+        Ok(reports.into_iter().map(Report::new).collect())
+    }
+
+    /// Many motions at once (row `i` of `Q0` to row `i` of `Q1`), on every core with the GIL
+    /// released: `(in_collision, fraction)` arrays, `fraction` NaN where free.
+    fn check_motions<'py>(&self, py: Python<'py>, q0: &Bound<'py, PyAny>, q1: &Bound<'py, PyAny>) -> PyResult<MotionArrays<'py>> {
+        let (a, b) = (rows(q0, &self.names, "Q0")?, rows(q1, &self.names, "Q1")?);
+        if a.len() != b.len() {
+            return Err(value_error(format!("Q0 has {} rows and Q1 {}: one motion per row", a.len(), b.len())));
+        }
+        let full = |rows: &[Vec<f64>]| rows.iter().map(|r| self.full(r)).collect::<Result<Vec<_>, _>>();
+        let (a, b) = (full(&a).map_err(state_error)?, full(&b).map_err(state_error)?);
+        let out: Vec<(bool, f64)> = py.detach(|| {
+            a.par_iter()
+                .zip(&b)
+                .map(|(x, y)| {
+                    let r = self.core.check_motion(x, y).report;
+                    (r.in_collision, r.fraction.unwrap_or(f64::NAN))
+                })
+                .collect()
+        });
+        let (flags, fractions): (Vec<bool>, Vec<f64>) = out.into_iter().unzip();
+        Ok((flags.into_pyarray(py), fractions.into_pyarray(py)))
+    }
+
+    /// Each link's smallest distance to the environment within `clearance_threshold` (a
+    /// `Checker` made with one), at `q`.
+    fn clearance(&self, py: Python<'_>, q: &Bound<'_, PyAny>) -> PyResult<Vec<crate::report::Clearance>> {
+        if self.core.params().clearance_threshold <= 0.0 {
+            return Err(error("clearance_threshold is 0: make the Checker with clearance_threshold=<metres>"));
+        }
+        Ok(self.check(py, q)?.clearances())
+    }
+
+    fn __repr__(&self) -> String {
+        let s = self.core.summary();
+        format!(
+            "Checker({}, {} joints; {}: {} thin surfaces, {} cells, {} solids)",
+            s.robot_source,
+            self.names.len(),
+            s.environment_source,
+            s.thin_surfaces,
+            s.cells,
+            s.solids
+        )
+    }
+}
