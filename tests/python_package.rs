@@ -10,7 +10,7 @@ use std::process::Command;
 
 #[test]
 fn the_python_package_passes_its_pytest_suite() {
-    let python = PathBuf::from(common::python());
+    let python = common::python();
     let venv = python.parent().and_then(|bin| bin.parent()).expect("TC_PYTHON is <venv>/bin/python").to_path_buf();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     // A target directory of its own: this test runs while `cargo test` holds target/'s lock.
