@@ -8,9 +8,10 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard};
 use thickness_collision::checker::{Checker as Core, StateError};
 use thickness_collision::model::{InputFiles, JointKind, Params, DEFAULT_NODE_FQN};
+use thickness_collision::pipeline::Pipeline;
 
 /// Per-row flags and fractions of a batch of motions.
 type MotionArrays<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>);
@@ -18,7 +19,9 @@ type MotionArrays<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>)
 /// A robot among its environment's thin surfaces and solids, as the node checks it.
 #[pyclass(frozen, module = "thickness_collision")]
 pub struct Checker {
-    core: Arc<Core>,
+    /// The scene in force and the joint state it was last given (for objects placed on robot
+    /// links); a check takes the checker in force and runs without the lock.
+    pipeline: Mutex<Pipeline>,
     /// The actuated joints (not mimic, not fixed), in model order: the order of every array.
     names: Vec<String>,
     /// Their indices in the model's joints.
@@ -30,19 +33,32 @@ fn state_error(e: StateError) -> PyErr {
 }
 
 impl Checker {
-    fn from_core(core: Core) -> Checker {
-        let (names, index) = core.robot().joints.iter().enumerate().filter(|(_, j)| j.is_actuated()).map(|(i, j)| (j.name.clone(), i)).unzip();
-        Checker { core: Arc::new(core), names, index }
-    }
-
     fn build(params: Params) -> PyResult<Checker> {
         params.validate().map_err(value_error)?;
-        Core::from_params(params).map(Checker::from_core).map_err(error)
+        let pipeline = Pipeline::new(params).map_err(error)?;
+        let robot = pipeline.checker().robot();
+        let (names, index) = robot.joints.iter().enumerate().filter(|(_, j)| j.is_actuated()).map(|(i, j)| (j.name.clone(), i)).unzip();
+        Ok(Checker { pipeline: Mutex::new(pipeline), names, index })
+    }
+
+    pub(crate) fn pipeline(&self) -> MutexGuard<'_, Pipeline> {
+        // A panic while the lock was held leaves a pipeline whose scene changes are whole or
+        // not made: it is still consistent.
+        self.pipeline.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// The checker in force (the planning scene's objects included).
+    pub(crate) fn core(&self) -> Arc<Core> {
+        self.pipeline().checker().clone()
+    }
+
+    pub(crate) fn names(&self) -> &[String] {
+        &self.names
     }
 
     /// Every joint's position from a row in `joint_names` order.
-    fn full(&self, row: &[f64]) -> Result<Vec<f64>, StateError> {
-        self.core.positions(&self.names, row)
+    fn full(&self, core: &Core, row: &[f64]) -> Result<Vec<f64>, StateError> {
+        core.positions(&self.names, row)
     }
 }
 
@@ -108,7 +124,8 @@ impl Checker {
     /// turn: a planner's bounds).
     #[getter]
     fn limits<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>) {
-        let joints = &self.core.robot().joints;
+        let core = self.core();
+        let joints = &core.robot().joints;
         let turn = |i: usize| -> [f64; 2] {
             match joints[i].kind {
                 JointKind::Continuous => [-std::f64::consts::PI, std::f64::consts::PI],
@@ -123,7 +140,8 @@ impl Checker {
     /// of `{name: value}` (a joint it lacks at 0).
     fn check(&self, py: Python<'_>, q: &Bound<'_, PyAny>) -> PyResult<Report> {
         let s = state(q, &self.names, "q")?;
-        let report = py.detach(|| self.core.check_joints(&s.names, &s.values)).map_err(state_error)?;
+        let core = self.core();
+        let report = py.detach(|| core.check_joints(&s.names, &s.values)).map_err(state_error)?;
         Ok(Report::new(report))
     }
 
@@ -132,14 +150,15 @@ impl Checker {
     #[pyo3(signature = (q, depths=false))]
     fn check_batch<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>, depths: bool) -> PyResult<Bound<'py, PyAny>> {
         let rows = rows(q, &self.names, "Q")?;
+        let core = self.core();
         let results: Vec<Result<(bool, f64), StateError>> = py.detach(|| {
             rows.par_iter()
                 .map(|row| {
                     if depths {
-                        let r = self.core.check_joints(&self.names, row)?;
+                        let r = core.check_joints(&self.names, row)?;
                         Ok((r.in_collision, r.contacts.iter().map(|c| c.depth).fold(0.0, f64::max)))
                     } else {
-                        Ok((self.core.check_joints_flags(&self.names, row)?.in_collision, 0.0))
+                        Ok((core.check_joints_flags(&self.names, row)?.in_collision, 0.0))
                     }
                 })
                 .collect()
@@ -158,20 +177,22 @@ impl Checker {
     /// certain; in collision, `fraction` is no later than the first contact.
     fn check_motion(&self, py: Python<'_>, q0: &Bound<'_, PyAny>, q1: &Bound<'_, PyAny>) -> PyResult<Report> {
         let (a, b) = (state(q0, &self.names, "q0")?, state(q1, &self.names, "q1")?);
-        let from = self.core.positions(&a.names, &a.values).map_err(state_error)?;
-        let to = self.core.positions(&b.names, &b.values).map_err(state_error)?;
-        Ok(Report::new(py.detach(|| self.core.check_motion(&from, &to).report)))
+        let core = self.core();
+        let from = core.positions(&a.names, &a.values).map_err(state_error)?;
+        let to = core.positions(&b.names, &b.values).map_err(state_error)?;
+        Ok(Report::new(py.detach(|| core.check_motion(&from, &to).report)))
     }
 
     /// The motions along a path (rows of `Q`), one report per edge, in order; the first edge in
     /// collision ends it (the reports stop there).
     fn check_path(&self, py: Python<'_>, q: &Bound<'_, PyAny>) -> PyResult<Vec<Report>> {
         let rows = rows(q, &self.names, "Q")?;
-        let full: Vec<Vec<f64>> = rows.iter().map(|r| self.full(r)).collect::<Result<_, _>>().map_err(state_error)?;
+        let core = self.core();
+        let full: Vec<Vec<f64>> = rows.iter().map(|r| self.full(&core, r)).collect::<Result<_, _>>().map_err(state_error)?;
         let reports = py.detach(|| {
             let mut out = Vec::with_capacity(full.len().saturating_sub(1));
             for edge in full.windows(2) {
-                let r = self.core.check_motion(&edge[0], &edge[1]).report;
+                let r = core.check_motion(&edge[0], &edge[1]).report;
                 let stop = r.in_collision;
                 out.push(r);
                 if stop {
@@ -190,13 +211,14 @@ impl Checker {
         if a.len() != b.len() {
             return Err(value_error(format!("Q0 has {} rows and Q1 {}: one motion per row", a.len(), b.len())));
         }
-        let full = |rows: &[Vec<f64>]| rows.iter().map(|r| self.full(r)).collect::<Result<Vec<_>, _>>();
+        let core = self.core();
+        let full = |rows: &[Vec<f64>]| rows.iter().map(|r| self.full(&core, r)).collect::<Result<Vec<_>, _>>();
         let (a, b) = (full(&a).map_err(state_error)?, full(&b).map_err(state_error)?);
         let out: Vec<(bool, f64)> = py.detach(|| {
             a.par_iter()
                 .zip(&b)
                 .map(|(x, y)| {
-                    let r = self.core.check_motion(x, y).report;
+                    let r = core.check_motion(x, y).report;
                     (r.in_collision, r.fraction.unwrap_or(f64::NAN))
                 })
                 .collect()
@@ -208,14 +230,84 @@ impl Checker {
     /// Each link's smallest distance to the environment within `clearance_threshold` (a
     /// `Checker` made with one), at `q`.
     fn clearance(&self, py: Python<'_>, q: &Bound<'_, PyAny>) -> PyResult<Vec<crate::report::Clearance>> {
-        if self.core.params().clearance_threshold <= 0.0 {
+        if self.core().params().clearance_threshold <= 0.0 {
             return Err(error("clearance_threshold is 0: make the Checker with clearance_threshold=<metres>"));
         }
         Ok(self.check(py, q)?.clearances())
     }
 
+    /// Each link's world pose at `q` (forward kinematics, the robot's base pose applied): a dict
+    /// of link name to a 4 x 4 matrix.
+    fn link_poses<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        let s = state(q, &self.names, "q")?;
+        let core = self.core();
+        let full = core.positions(&s.names, &s.values).map_err(state_error)?;
+        let poses = core.robot().forward_kinematics(&full, core.base_pose()).map_err(value_error)?;
+        let out = pyo3::types::PyDict::new(py);
+        for (link, iso) in core.robot().links.iter().zip(&poses) {
+            out.set_item(&link.name, crate::geometry::matrix(&thickness_collision::math::pose_from_isometry(iso)).into_pyarray(py))?;
+        }
+        Ok(out)
+    }
+
+    /// The collision geometry each checked link is checked with, in its link's frame: a dict of
+    /// link name to a list of `(kind, data, offset)`: `("hull", N x 3 points, 4 x 4)`,
+    /// `("sphere", radius, ...)`, `("capsule" | "cylinder", (half_height, radius), ...)` (along z).
+    fn collision_geometry<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        use thickness_collision::collision::TargetShape;
+        let core = self.core();
+        let out = pyo3::types::PyDict::new(py);
+        for t in core.targets() {
+            let parts = pyo3::types::PyList::empty(py);
+            for (shape, offset) in &t.parts {
+                let offset = crate::geometry::matrix(offset).into_pyarray(py);
+                let item = match shape {
+                    TargetShape::Polytope(h) => {
+                        let pts = numpy::ndarray::Array2::from_shape_fn((h.points().len(), 3), |(i, d)| h.points()[i][d]);
+                        ("hull", pts.into_pyarray(py).into_any(), offset).into_pyobject(py)?
+                    }
+                    TargetShape::Sphere { radius } => ("sphere", radius.into_pyobject(py)?.into_any(), offset).into_pyobject(py)?,
+                    TargetShape::Capsule { half_height, radius } => {
+                        ("capsule", (*half_height, *radius).into_pyobject(py)?.into_any(), offset).into_pyobject(py)?
+                    }
+                    TargetShape::Cylinder { half_height, radius } => {
+                        ("cylinder", (*half_height, *radius).into_pyobject(py)?.into_any(), offset).into_pyobject(py)?
+                    }
+                };
+                parts.append(item)?;
+            }
+            out.set_item(&t.name, parts)?;
+        }
+        Ok(out)
+    }
+
+    /// Applies a `moveit_msgs/CollisionObject` (a dict with the message's field names, lists
+    /// for sequences; `thickness_collision.collision_object` makes one) as the node applies the
+    /// `collision_object` topic: in force when this returns. With `q`, that joint state is made
+    /// the current one first (an object placed on a robot link is placed at it).
+    #[pyo3(signature = (msg, q=None))]
+    fn apply_collision_object(&self, msg: &Bound<'_, PyAny>, q: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+        crate::scene_msgs::apply_collision_object(self, msg, q)
+    }
+
+    /// Applies a `moveit_msgs/AttachedCollisionObject` dict (attach, or detach with
+    /// `object.operation` REMOVE) as the node applies the `attached_collision_object` topic;
+    /// with `q`, that joint state is made the current one first (an attachment keeps the
+    /// object's pose at it).
+    #[pyo3(signature = (msg, q=None))]
+    fn apply_attached_collision_object(&self, msg: &Bound<'_, PyAny>, q: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+        crate::scene_msgs::apply_attached_collision_object(self, msg, q)
+    }
+
+    /// (world objects, attached objects) of the planning scene in force.
+    #[getter]
+    fn scene_object_count(&self) -> (usize, usize) {
+        self.pipeline().scene_object_count()
+    }
+
     fn __repr__(&self) -> String {
-        let s = self.core.summary();
+        let core = self.core();
+        let s = core.summary();
         format!(
             "Checker({}, {} joints; {}: {} thin surfaces, {} cells, {} solids)",
             s.robot_source,

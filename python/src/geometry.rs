@@ -82,6 +82,25 @@ fn pose(transform: Option<&Bound<'_, PyAny>>) -> PyResult<Pose> {
     Ok(pose_from_isometry(&iso))
 }
 
+/// A pose as a 4 x 4 homogeneous matrix.
+pub fn matrix(p: &Pose) -> Array2<f64> {
+    let q = p.rotation;
+    let (x, y, z, w) = (q.x, q.y, q.z, q.w);
+    #[rustfmt::skip]
+    let r = [
+        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
+        [2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)],
+        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)],
+    ];
+    let t = [p.translation.x, p.translation.y, p.translation.z];
+    Array2::from_shape_fn((4, 4), |(i, j)| match (i, j) {
+        (3, 3) => 1.0,
+        (3, _) => 0.0,
+        (i, 3) => t[i],
+        (i, j) => r[i][j],
+    })
+}
+
 /// The cells behind every triangle of a mesh: a dict of arrays, `back_cap` and `front_cap`
 /// (`N x 3 x 3`, each cap's three corners), `normal` (`N x 3`), `triangle` (`N`, the input
 /// triangle each cell stands behind).

@@ -8,6 +8,7 @@ mod errors;
 mod geometry;
 mod positions;
 mod report;
+mod scene_msgs;
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -52,32 +52,11 @@ impl Clearance {
     }
 }
 
-/// A state's (or a motion's) report.
+/// A state's (or a motion's) report. Its Python objects are made when they are read: a check
+/// that only asks `in_collision` pays for nothing else.
 #[pyclass(frozen, module = "thickness_collision")]
 pub struct Report {
-    /// True when in collision, and when the state could not be checked (see `error`).
-    #[pyo3(get)]
-    in_collision: bool,
-    #[pyo3(get)]
-    contacts: Vec<Contact>,
-    #[pyo3(get)]
-    clearances: Vec<Clearance>,
-    /// Joints outside their limits.
-    #[pyo3(get)]
-    out_of_limits: Vec<String>,
-    /// Why the state could not be checked ("" when it was).
-    #[pyo3(get)]
-    error: String,
-    /// A motion's report.
-    #[pyo3(get)]
-    motion: bool,
-    /// For a motion in collision: the start of the first stretch that could not be cleared.
-    #[pyo3(get)]
-    fraction: Option<f64>,
-    /// Seconds the check took.
-    #[pyo3(get)]
-    check_seconds: f64,
-    json: String,
+    inner: StateReport,
 }
 
 fn triple(a: [f64; 3]) -> (f64, f64, f64) {
@@ -109,48 +88,85 @@ fn clearance(c: &ReportClearance) -> Clearance {
 }
 
 impl Report {
-    pub fn new(report: StateReport) -> Report {
-        let r = &report;
-        let fields = Report {
-            in_collision: r.in_collision,
-            contacts: r.contacts.iter().map(contact).collect(),
-            clearances: r.clearances.iter().map(clearance).collect(),
-            out_of_limits: r.out_of_limits.clone(),
-            error: r.error.clone(),
-            motion: r.motion,
-            fraction: r.fraction,
-            check_seconds: r.check_seconds,
-            json: String::new(),
-        };
-        Report { json: CheckedState { stamp: Time::default(), report }.json(), ..fields }
+    pub fn new(inner: StateReport) -> Report {
+        Report { inner }
     }
-}
 
-impl Report {
     pub fn clearances(&self) -> Vec<Clearance> {
-        self.clearances.clone()
+        self.inner.clearances.iter().map(clearance).collect()
     }
 }
 
 #[pymethods]
 impl Report {
+    /// True when in collision, and when the state could not be checked (see `error`).
+    #[getter]
+    fn in_collision(&self) -> bool {
+        self.inner.in_collision
+    }
+
+    /// The contacts: one per link (its deepest) and per colliding self pair.
+    #[getter]
+    fn contacts(&self) -> Vec<Contact> {
+        self.inner.contacts.iter().map(contact).collect()
+    }
+
+    /// Each link within `clearance_threshold` of the environment (signed: minus the depth in
+    /// contact).
+    #[getter(clearances)]
+    fn clearances_py(&self) -> Vec<Clearance> {
+        self.clearances()
+    }
+
+    /// Joints outside their limits.
+    #[getter]
+    fn out_of_limits(&self) -> Vec<String> {
+        self.inner.out_of_limits.clone()
+    }
+
+    /// Why the state could not be checked ("" when it was).
+    #[getter]
+    fn error(&self) -> &str {
+        &self.inner.error
+    }
+
+    /// A motion's report.
+    #[getter]
+    fn motion(&self) -> bool {
+        self.inner.motion
+    }
+
+    /// For a motion in collision: the start of the first stretch that could not be cleared.
+    #[getter]
+    fn fraction(&self) -> Option<f64> {
+        self.inner.fraction
+    }
+
+    /// Seconds the check took.
+    #[getter]
+    fn check_seconds(&self) -> f64 {
+        self.inner.check_seconds
+    }
+
     /// Exactly the object `check --json` prints for this state (`stamp` 0).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        py.import("json")?.call_method1("loads", (&self.json,))
+        let json = CheckedState { stamp: Time::default(), report: self.inner.clone() }.json();
+        py.import("json")?.call_method1("loads", (json,))
     }
 
     fn __bool__(&self) -> bool {
-        self.in_collision
+        self.inner.in_collision
     }
 
     fn __repr__(&self) -> String {
-        if !self.error.is_empty() {
-            return format!("Report(not checked, in collision: {})", self.error);
+        let r = &self.inner;
+        if !r.error.is_empty() {
+            return format!("Report(not checked, in collision: {})", r.error);
         }
-        match (self.motion, self.fraction) {
-            (true, Some(f)) => format!("Report(motion in collision from {f:.4}, {} contacts)", self.contacts.len()),
+        match (r.motion, r.fraction) {
+            (true, Some(f)) => format!("Report(motion in collision from {f:.4}, {} contacts)", r.contacts.len()),
             (true, None) => "Report(motion free)".into(),
-            _ => format!("Report(in_collision={}, {} contacts)", if self.in_collision { "True" } else { "False" }, self.contacts.len()),
+            _ => format!("Report(in_collision={}, {} contacts)", if r.in_collision { "True" } else { "False" }, r.contacts.len()),
         }
     }
 }

@@ -187,3 +187,23 @@ def test_bundled_workcell():
     c = tc.Checker()
     assert len(c.joint_names) == 7 and "workcell" in repr(c)
     assert not c.check(np.zeros(7)).in_collision
+
+
+def test_link_poses_match_yourdfpy(panda, panda_urdf):
+    import yourdfpy  # an independent URDF parser and FK (scripts/setup_venv.sh)
+
+    robot = yourdfpy.URDF.load(str(panda_urdf), load_meshes=False, build_scene_graph=True, load_collision_meshes=False)
+    base = np.eye(4)
+    base[2, 3] = 0.005  # panda_params' robot_base_pose
+    for row in random_states(panda, 20, 13):
+        robot.update_cfg({n: float(v) for n, v in zip(panda.joint_names, row) if n in robot.actuated_joint_names})
+        ours = panda.link_poses(row)
+        for link in ["panda_link3", "panda_link7", "panda_hand", "panda_leftfinger"]:
+            np.testing.assert_allclose(ours[link], base @ robot.get_transform(link), atol=1e-9)
+
+
+def test_collision_geometry_is_what_is_checked(panda):
+    geometry = panda.collision_geometry()
+    assert "panda_hand" in geometry and all(len(parts) >= 1 for parts in geometry.values())
+    kind, points, offset = geometry["panda_hand"][0]
+    assert kind == "hull" and points.shape[1] == 3 and offset.shape == (4, 4)

@@ -10,10 +10,10 @@ mod bounded;
 mod check_states;
 mod definitions;
 pub(crate) mod moveit;
-// The scene's messages are decoded by the tests alone until the node subscribes to MoveIt's
-// scene topics and serves its scene services.
-#[cfg_attr(not(test), expect(dead_code, reason = "the node does not read the planning scene yet"))]
-pub(crate) mod planning_scene;
+// Public for the objects a library user applies to a pipeline (`CollisionObject`,
+// `AttachedCollisionObject`); the rest of the scene's messages are the node's and replay's.
+#[cfg_attr(not(test), expect(dead_code, reason = "some scene messages are read by the node alone"))]
+pub mod planning_scene;
 #[cfg(test)]
 mod planning_scene_tests;
 

@@ -42,8 +42,10 @@ impl ScenePlan {
 }
 
 impl Pipeline {
-    /// A `moveit_msgs/CollisionObject` (the `collision_object` topic).
-    pub(crate) fn collision_object(&mut self, msg: &CollisionObject) -> Result<(), Skip> {
+    /// A `moveit_msgs/CollisionObject` (the `collision_object` topic), applied as MoveIt applies
+    /// it (docs/reference.md, "Planning scene"): in force when this returns. A refusal names the
+    /// field and leaves the scene unchanged.
+    pub fn collision_object(&mut self, msg: &CollisionObject) -> Result<(), Skip> {
         let plan = self.prepare_collision_object(msg)?;
         self.install_scene(plan.build())
     }
@@ -63,7 +65,7 @@ impl Pipeline {
     }
 
     /// A `moveit_msgs/AttachedCollisionObject` (the `attached_collision_object` topic).
-    pub(crate) fn attached_collision_object(&mut self, msg: &AttachedCollisionObject) -> Result<(), Skip> {
+    pub fn attached_collision_object(&mut self, msg: &AttachedCollisionObject) -> Result<(), Skip> {
         let plan = self.prepare_attached_collision_object(msg)?;
         self.install_scene(plan.build())
     }

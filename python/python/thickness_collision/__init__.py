@@ -7,5 +7,6 @@ thickness_collision[ompl]``). See docs/python.md.
 """
 
 from ._native import Checker, Clearance, Contact, Error, Report, Scene, areas
+from .messages import attached_object, collision_object, pose
 
-__all__ = ["Checker", "Clearance", "Contact", "Error", "Report", "Scene", "areas"]
+__all__ = ["Checker", "Clearance", "Contact", "Error", "Report", "Scene", "areas", "attached_object", "collision_object", "pose"]
