@@ -141,7 +141,7 @@ impl Checker {
     fn check(&self, py: Python<'_>, q: &Bound<'_, PyAny>) -> PyResult<Report> {
         let s = state(q, &self.names, "q")?;
         let core = self.core();
-        let report = py.detach(|| core.check_joints(&s.names, &s.values)).map_err(state_error)?;
+        let report = py.detach(|| core.check_joints(s.names(&self.names), &s.values)).map_err(state_error)?;
         Ok(Report::new(report))
     }
 
@@ -178,8 +178,8 @@ impl Checker {
     fn check_motion(&self, py: Python<'_>, q0: &Bound<'_, PyAny>, q1: &Bound<'_, PyAny>) -> PyResult<Report> {
         let (a, b) = (state(q0, &self.names, "q0")?, state(q1, &self.names, "q1")?);
         let core = self.core();
-        let from = core.positions(&a.names, &a.values).map_err(state_error)?;
-        let to = core.positions(&b.names, &b.values).map_err(state_error)?;
+        let from = core.positions(a.names(&self.names), &a.values).map_err(state_error)?;
+        let to = core.positions(b.names(&self.names), &b.values).map_err(state_error)?;
         Ok(Report::new(py.detach(|| core.check_motion(&from, &to).report)))
     }
 
@@ -236,12 +236,29 @@ impl Checker {
         Ok(self.check(py, q)?.clearances())
     }
 
+    /// The benchmark's instrument (benches/python_layer.py): the Rust API's `check_joints` on
+    /// each row of `Q` in turn, in this process, timed in Rust; returns (seconds per row, rows
+    /// in collision). Beside a Python loop of `check` on the same rows it measures what the
+    /// Python layer adds per call.
+    fn _time_rust_checks(&self, py: Python<'_>, q: &Bound<'_, PyAny>) -> PyResult<(f64, usize)> {
+        let rows = rows(q, &self.names, "Q")?;
+        let core = self.core();
+        py.detach(|| {
+            let started = std::time::Instant::now();
+            let mut colliding = 0;
+            for row in &rows {
+                colliding += core.check_joints(&self.names, row).map_err(state_error)?.in_collision as usize;
+            }
+            Ok((started.elapsed().as_secs_f64() / rows.len().max(1) as f64, colliding))
+        })
+    }
+
     /// Each link's world pose at `q` (forward kinematics, the robot's base pose applied): a dict
     /// of link name to a 4 x 4 matrix.
     fn link_poses<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
         let s = state(q, &self.names, "q")?;
         let core = self.core();
-        let full = core.positions(&s.names, &s.values).map_err(state_error)?;
+        let full = core.positions(s.names(&self.names), &s.values).map_err(state_error)?;
         let poses = core.robot().forward_kinematics(&full, core.base_pose()).map_err(value_error)?;
         let out = pyo3::types::PyDict::new(py);
         for (link, iso) in core.robot().links.iter().zip(&poses) {

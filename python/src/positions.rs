@@ -9,8 +9,20 @@ use pyo3::types::PyDict;
 
 /// Names and values of one state.
 pub struct State {
-    pub names: Vec<String>,
+    /// The names a dict gave; empty for values in `joint_names` order (not copied per call).
+    names: Vec<String>,
     pub values: Vec<f64>,
+}
+
+impl State {
+    /// The joints the values are for.
+    pub fn names<'a>(&'a self, joint_names: &'a [String]) -> &'a [String] {
+        if self.names.is_empty() {
+            joint_names
+        } else {
+            &self.names
+        }
+    }
 }
 
 /// `values` checked against `names` (the checker's `joint_names`): as many, all finite.
@@ -46,7 +58,7 @@ pub fn state(q: &Bound<'_, PyAny>, joint_names: &[String], what: &str) -> PyResu
     } else {
         q.extract().map_err(|_| value_error(format!("{what}: a sequence of numbers in joint_names order, or a dict of name: value")))?
     };
-    Ok(State { names: joint_names.to_vec(), values: checked(joint_names, values, what)? })
+    Ok(State { names: Vec::new(), values: checked(joint_names, values, what)? })
 }
 
 /// Rows of an `N x dof` array (or a sequence of sequences), each checked as a state.

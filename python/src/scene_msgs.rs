@@ -53,7 +53,7 @@ fn message<T: Default + Serialize + DeserializeOwned>(msg: &Bound<'_, PyAny>, wh
 fn set_state(checker: &Checker, q: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
     let Some(q) = q else { return Ok(()) };
     let s = crate::positions::state(q, checker.names(), "q")?;
-    let msg = JointState { name: s.names, position: s.values, ..Default::default() };
+    let msg = JointState { name: s.names(checker.names()).to_vec(), position: s.values, ..Default::default() };
     checker.pipeline().joint_state(&msg).map(|_| ()).map_err(|skip| value_error(skip.message))
 }
 
