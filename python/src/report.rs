@@ -28,6 +28,24 @@ pub struct Contact {
 
 #[pymethods]
 impl Contact {
+    /// `link_name`, by its short name.
+    #[getter]
+    fn link(&self) -> &str {
+        &self.link_name
+    }
+
+    /// `object_name`, by its short name.
+    #[getter]
+    fn object(&self) -> &str {
+        &self.object_name
+    }
+
+    /// `position`: the contact point (world), or `None` when not computed.
+    #[getter]
+    fn point(&self) -> Option<(f64, f64, f64)> {
+        self.position
+    }
+
     fn __repr__(&self) -> String {
         format!("Contact({} x {} ({}), depth {:.6})", self.link_name, self.object_name, self.object_type, self.depth)
     }

@@ -46,6 +46,8 @@ def test_check_equals_check_json(panda, panda_params):
         assert r.in_collision == d["in_collision"] and len(r.contacts) == len(d["contacts"])
         for c, cd in zip(r.contacts, d["contacts"]):
             assert (c.link_name, c.object_name, c.object_type, c.triangle, c.depth) == (cd["link_name"], cd["object_name"], cd["object_type"], cd["triangle"], cd["depth"])
+            assert (c.link, c.object, c.point) == (c.link_name, c.object_name, tuple(cd["position"]) if cd["position"] else None)
+            assert c.normal == tuple(cd["normal"])
         colliding += r.in_collision
     assert STATES // 10 < colliding < STATES, f"{colliding} of {STATES} states collide: both outcomes are needed"
 

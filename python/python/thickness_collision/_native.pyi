@@ -19,6 +19,12 @@ class Contact:
     depth: float
     normal: Tuple[float, float, float]
     position: Optional[Tuple[float, float, float]]
+    @property
+    def link(self) -> str: ...
+    @property
+    def object(self) -> str: ...
+    @property
+    def point(self) -> Optional[Tuple[float, float, float]]: ...
 
 class Clearance:
     link_name: str
