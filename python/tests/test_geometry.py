@@ -4,17 +4,11 @@ import numpy as np
 import pytest
 
 import thickness_collision as tc
+from meshes import grid_sheet
 
 
 def sheet(n=10, size=1.0):
-    xs = np.linspace(0, size, n + 1)
-    v = np.array([[x, y, 0.0] for y in xs for x in xs])
-    f = []
-    for j in range(n):
-        for i in range(n):
-            a = j * (n + 1) + i
-            f += [[a, a + 1, a + n + 2], [a, a + n + 2, a + n + 1]]
-    return v, np.array(f)
+    return grid_sheet(n, size)
 
 
 def cube(half):

@@ -6,18 +6,12 @@ import numpy as np
 import pytest
 
 import thickness_collision as tc
-from thickness_collision.messages import ADD, MOVE, REMOVE
+from meshes import grid_sheet
+from thickness_collision.messages import MOVE, REMOVE
 
 
 def sheet(n=4, size=0.12):
-    xs = np.linspace(-size / 2, size / 2, n + 1)
-    v = np.array([[x, y, 0.0] for y in xs for x in xs])
-    f = []
-    for j in range(n):
-        for i in range(n):
-            a = j * (n + 1) + i
-            f += [[a, a + 1, a + n + 2], [a, a + n + 2, a + n + 1]]
-    return v, np.array(f)
+    return grid_sheet(n, size, centred=True)
 
 
 @pytest.fixture()

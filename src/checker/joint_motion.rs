@@ -60,6 +60,14 @@ pub(super) fn point_acceleration(robot: &RobotModel, levers: &[(usize, Real)], d
     total
 }
 
+/// A revolute joint's axis in the world (its child link at `child`), and how far the origin of a
+/// link at `link` lies from that axis: what a lever is tightened to at the middle of a stretch.
+pub(super) fn axis_and_offset(joint: &crate::model::JointModel, child: &Pose, link: &Pose) -> (Vector, Real) {
+    let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
+    let rel = link.translation - child.translation;
+    (axis, (rel - axis * rel.dot(axis)).length())
+}
+
 /// What the joints below a target do to it at the middle of a stretch (see `JointPath::bound`).
 struct Moved {
     /// `Σ_j |Δq_j| · lever_j`, each lever tightened at the middle.
@@ -94,9 +102,7 @@ impl JointPath<'_> {
             let joint = &robot.joints[j];
             let lever = match (joint.kind, poses[joint.child]) {
                 (JointKind::Revolute | JointKind::Continuous, Some(child)) => {
-                    let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
-                    let rel = link.translation - child.translation;
-                    let off_axis = (rel - axis * rel.dot(axis)).length();
+                    let (axis, off_axis) = axis_and_offset(joint, &child, &link);
                     moved.omega += axis * self.delta[j];
                     moved.velocity += axis.cross(c - child.translation) * self.delta[j];
                     r.min(off_axis + reach + half * below)

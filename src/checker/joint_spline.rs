@@ -15,6 +15,7 @@
 //! narrowed (`MotionPath::floor`).
 
 use super::checker::Checker;
+use super::joint_motion::axis_and_offset;
 use super::motion_sweep::{MotionPath, MotionReport};
 use super::spline_poly::SegmentPoly;
 use super::state_report::StateReport;
@@ -95,9 +96,7 @@ impl SplinePath<'_> {
             let joint = &robot.joints[j];
             let lever = match (joint.kind, poses[joint.child]) {
                 (JointKind::Revolute | JointKind::Continuous, Some(child)) => {
-                    let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
-                    let rel = link.translation - child.translation;
-                    let off_axis = (rel - axis * rel.dot(axis)).length();
+                    let (_, off_axis) = axis_and_offset(joint, &child, &link);
                     r.min(off_axis + reach + below)
                 }
                 _ => r,
