@@ -33,15 +33,7 @@ fn main() {
     let rounds = env_usize("ROUNDS", 3);
     let py = peer_compare_core::python();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let venv = py.parent().and_then(|b| b.parent()).unwrap().to_path_buf();
-    let built = Command::new(&py)
-        .args(["-m", "maturin", "develop", "--release", "--manifest-path"])
-        .arg(root.join("python/Cargo.toml"))
-        .env("VIRTUAL_ENV", &venv)
-        .env("CARGO_TARGET_DIR", root.join("target/python"))
-        .status()
-        .unwrap();
-    assert!(built.success(), "maturin develop");
+    peer_compare_core::scaffold::develop_python_package(&py);
     let (_, map) = peer_compare_core::panda(&py);
     let erd = map[0].split_once('=').unwrap().1.to_owned();
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("python_layer");

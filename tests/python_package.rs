@@ -11,18 +11,8 @@ use std::process::Command;
 #[test]
 fn the_python_package_passes_its_pytest_suite() {
     let python = common::python();
-    let venv = python.parent().and_then(|bin| bin.parent()).expect("TC_PYTHON is <venv>/bin/python").to_path_buf();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    // A target directory of its own: this test runs while `cargo test` holds target/'s lock.
-    let target = root.join("target").join("python");
-    let status = Command::new(&python)
-        .args(["-m", "maturin", "develop", "--release", "--manifest-path"])
-        .arg(root.join("python/Cargo.toml"))
-        .env("VIRTUAL_ENV", &venv)
-        .env("CARGO_TARGET_DIR", &target)
-        .status()
-        .expect("maturin (scripts/setup_venv.sh installs it)");
-    assert!(status.success(), "maturin develop failed");
+    common::develop_python_package(&python);
     let out = Command::new(&python)
         .args(["-m", "pytest", "-q", "-p", "no:cacheprovider", "python/tests"])
         .current_dir(&root)

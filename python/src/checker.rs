@@ -2,7 +2,7 @@
 //! threads at once (the library's checker is immutable after loading; the class is frozen).
 
 use crate::errors::{error, value_error};
-use crate::positions::{rows, state};
+use crate::positions::{rows, state, State};
 use crate::report::Report;
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
@@ -56,9 +56,14 @@ impl Checker {
         &self.names
     }
 
-    /// Every joint's position from a row in `joint_names` order.
-    fn full(&self, core: &Core, row: &[f64]) -> Result<Vec<f64>, StateError> {
-        core.positions(&self.names, row)
+    /// Every joint's position from one state.
+    fn full(&self, core: &Core, s: &State) -> PyResult<Vec<f64>> {
+        core.positions(s.names(&self.names), &s.values).map_err(state_error)
+    }
+
+    /// Every joint's position from each row (in `joint_names` order).
+    fn full_rows(&self, core: &Core, rows: &[Vec<f64>]) -> PyResult<Vec<Vec<f64>>> {
+        rows.iter().map(|row| core.positions(&self.names, row).map_err(state_error)).collect()
     }
 }
 
@@ -132,7 +137,7 @@ impl Checker {
                 _ => joints[i].limits,
             }
         };
-        let (lo, hi): (Vec<f64>, Vec<f64>) = self.index.iter().map(|&i| (turn(i)[0], turn(i)[1])).unzip();
+        let (lo, hi): (Vec<f64>, Vec<f64>) = self.index.iter().map(|&i| turn(i).into()).unzip();
         (lo.into_pyarray(py), hi.into_pyarray(py))
     }
 
@@ -178,8 +183,7 @@ impl Checker {
     fn check_motion(&self, py: Python<'_>, q0: &Bound<'_, PyAny>, q1: &Bound<'_, PyAny>) -> PyResult<Report> {
         let (a, b) = (state(q0, &self.names, "q0")?, state(q1, &self.names, "q1")?);
         let core = self.core();
-        let from = core.positions(a.names(&self.names), &a.values).map_err(state_error)?;
-        let to = core.positions(b.names(&self.names), &b.values).map_err(state_error)?;
+        let (from, to) = (self.full(&core, &a)?, self.full(&core, &b)?);
         Ok(Report::new(py.detach(|| core.check_motion(&from, &to).report)))
     }
 
@@ -188,7 +192,7 @@ impl Checker {
     fn check_path(&self, py: Python<'_>, q: &Bound<'_, PyAny>) -> PyResult<Vec<Report>> {
         let rows = rows(q, &self.names, "Q")?;
         let core = self.core();
-        let full: Vec<Vec<f64>> = rows.iter().map(|r| self.full(&core, r)).collect::<Result<_, _>>().map_err(state_error)?;
+        let full = self.full_rows(&core, &rows)?;
         let reports = py.detach(|| {
             let mut out = Vec::with_capacity(full.len().saturating_sub(1));
             for edge in full.windows(2) {
@@ -212,8 +216,7 @@ impl Checker {
             return Err(value_error(format!("Q0 has {} rows and Q1 {}: one motion per row", a.len(), b.len())));
         }
         let core = self.core();
-        let full = |rows: &[Vec<f64>]| rows.iter().map(|r| self.full(&core, r)).collect::<Result<Vec<_>, _>>();
-        let (a, b) = (full(&a).map_err(state_error)?, full(&b).map_err(state_error)?);
+        let (a, b) = (self.full_rows(&core, &a)?, self.full_rows(&core, &b)?);
         let out: Vec<(bool, f64)> = py.detach(|| {
             a.par_iter()
                 .zip(&b)
@@ -258,7 +261,7 @@ impl Checker {
     fn link_poses<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
         let s = state(q, &self.names, "q")?;
         let core = self.core();
-        let full = core.positions(s.names(&self.names), &s.values).map_err(state_error)?;
+        let full = self.full(&core, &s)?;
         let poses = core.robot().forward_kinematics(&full, core.base_pose()).map_err(value_error)?;
         let out = pyo3::types::PyDict::new(py);
         for (link, iso) in core.robot().links.iter().zip(&poses) {

@@ -19,7 +19,7 @@ impl Checker {
     /// it lacks is at 0 (an error under `missing_joint: reject`). Positions outside limits are
     /// flagged in the report.
     pub fn check_joints(&self, names: &[String], positions: &[f64]) -> Result<StateReport, StateError> {
-        let q = resolve_positions(&self.robot, names, positions, self.params.missing_joint)?;
+        let q = self.positions(names, positions)?;
         self.check_positions(&q)
     }
 
@@ -34,7 +34,7 @@ impl Checker {
     /// its contact carries only link and object names (no depth, point or normal). The
     /// like-for-like counterpart of a boolean `collide` in FCL or coal.
     pub fn check_joints_flags(&self, names: &[String], positions: &[f64]) -> Result<StateReport, StateError> {
-        let q = resolve_positions(&self.robot, names, positions, self.params.missing_joint)?;
+        let q = self.positions(names, positions)?;
         self.check_positions_with(&q, &CollideSettings { flag_only: true, least_overlap: false, ..Default::default() })
     }
 

@@ -3,8 +3,9 @@
 //! the link, grown by the stretch's bound, that is apart from every box clears the stretch at any
 //! growth, at the cost of a few box distances instead of a walk of the cells.
 
+use super::cell_tree::CellTree;
 use super::scene::{ObjectBody, Scene};
-use crate::math::{Real, Vector};
+use crate::math::{Aabb, Real, Vector};
 
 /// Tree nodes a ball may visit before it gives up: past that it is near enough to the cells that
 /// the hull test is the better question.
@@ -15,6 +16,49 @@ const NODE_BUDGET: usize = 48;
 fn box_distance_squared(p: Vector, centre: Vector, half: Vector) -> Real {
     let d = ((p - centre).abs() - half).max(Vector::ZERO);
     d.dot(d)
+}
+
+/// [`box_distance_squared`] to an axis-aligned box given by its corners.
+#[inline]
+fn aabb_distance_squared(p: Vector, b: &Aabb) -> Real {
+    box_distance_squared(p, (b.mins + b.maxs) * 0.5, (b.maxs - b.mins) * 0.5)
+}
+
+/// Whether the ball about `local` (the tree's frame) with squared radius `r2` is apart from the
+/// box of every cell of `tree`, walking down the node boxes it meets; `visits` counts the nodes
+/// against [`NODE_BUDGET`] (spent: no verdict).
+fn apart_from_cells(tree: &CellTree, local: Vector, r2: Real, visits: &mut usize) -> bool {
+    if tree.is_empty() {
+        return true;
+    }
+    // No allocation: each visit pops one node and pushes at most two, so after `k` visits at most
+    // `k + 1` wait, and the budget stops the walk at `NODE_BUDGET` visits.
+    let mut stack = [0u32; NODE_BUDGET + 2];
+    let mut len = 1;
+    while len > 0 {
+        len -= 1;
+        let node = stack[len];
+        *visits += 1;
+        if *visits > NODE_BUDGET {
+            return false;
+        }
+        let (c, h) = tree.node_box(node);
+        if box_distance_squared(local, c, h) > r2 {
+            continue;
+        }
+        match tree.children(node) {
+            Some(children) => {
+                stack[len..len + 2].copy_from_slice(&children);
+                len += 2;
+            }
+            None => {
+                if tree.leaf_cells(node).any(|(_, slab)| !(box_distance_squared(local, slab.centre(), slab.half()) > r2)) {
+                    return false;
+                }
+            }
+        }
+    }
+    true
 }
 
 impl Scene {
@@ -28,50 +72,16 @@ impl Scene {
         }
         let r2 = radius * radius;
         let mut visits = 0usize;
-        let mut stack: Vec<u32> = Vec::with_capacity(32);
-        for (oi, object) in self.objects().iter().enumerate() {
-            if !check(oi) {
-                continue;
+        self.objects().iter().enumerate().all(|(oi, object)| {
+            if !check(oi) || aabb_distance_squared(centre, &object.world_aabb) > r2 {
+                return true;
             }
-            let world = &object.world_aabb;
-            if !(box_distance_squared(centre, (world.mins + world.maxs) * 0.5, (world.maxs - world.mins) * 0.5) > r2) {
-                let local = object.pose.inverse() * centre;
-                match &*object.body {
-                    ObjectBody::Solid(shape) => {
-                        let b = shape.local_aabb();
-                        if !(box_distance_squared(local, (b.mins + b.maxs) * 0.5, (b.maxs - b.mins) * 0.5) > r2) {
-                            return false;
-                        }
-                    }
-                    ObjectBody::Surface { tree, .. } => {
-                        if tree.is_empty() {
-                            continue;
-                        }
-                        stack.clear();
-                        stack.push(0);
-                        while let Some(node) = stack.pop() {
-                            visits += 1;
-                            if visits > NODE_BUDGET {
-                                return false;
-                            }
-                            let (c, h) = tree.node_box(node);
-                            if box_distance_squared(local, c, h) > r2 {
-                                continue;
-                            }
-                            match tree.children(node) {
-                                Some(children) => stack.extend(children),
-                                None => {
-                                    if tree.leaf_cells(node).any(|(_, slab)| !(box_distance_squared(local, slab.centre(), slab.half()) > r2)) {
-                                        return false;
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
+            let local = object.pose.inverse() * centre;
+            match &*object.body {
+                ObjectBody::Solid(shape) => aabb_distance_squared(local, &shape.local_aabb()) > r2,
+                ObjectBody::Surface { tree, .. } => apart_from_cells(tree, local, r2, &mut visits),
             }
-        }
-        true
+        })
     }
 }
 

@@ -18,7 +18,7 @@ mod scene_memory;
 #[allow(unused_imports)]
 pub use self::bundled_arm::{arm_srdfs, arm_with_tray, random_arm_states};
 #[allow(unused_imports)]
-pub use self::scaffold::{emptied, mesh_area, scratch_dir, scratch_subdir, thin_area, topology, topology_area, write_le, LeBytes};
+pub use self::scaffold::{develop_python_package, emptied, mesh_area, scratch_dir, scratch_subdir, thin_area, topology, topology_area, write_le, LeBytes};
 #[allow(unused_imports)]
 pub use self::scene_memory::{cells_bytes, resident_bytes};
 

@@ -1,6 +1,7 @@
 //! Scaffolding every kind of test uses: a scratch folder per test file (and one per test inside
-//! it), raw little-endian arrays for the Python peers, and a thickness area straight from a
-//! triangle soup. The benches include this file too (`#[path]`).
+//! it), raw little-endian arrays for the Python peers, a thickness area straight from a
+//! triangle soup, and the Python package built into the peers' venv. The benches include this
+//! file too (`#[path]`).
 
 use std::path::{Path, PathBuf};
 use thickness_collision::math::{Real, Vector};
@@ -94,4 +95,20 @@ pub fn mesh_area(vertices: &[Vector], triangles: &[[u32; 3]], settings: &Thickne
 /// [`mesh_area`] with only the thickness set (metres).
 pub fn thin_area(vertices: &[Vector], triangles: &[[u32; 3]], thickness: Real) -> ThicknessArea {
     mesh_area(vertices, triangles, &ThicknessSettings { thickness, ..Default::default() })
+}
+
+/// Builds the Python package (`python/`) into the venv of `python` (`<venv>/bin/python`) with
+/// `maturin develop --release`, as an installed wheel would be, in a target directory of its own:
+/// a test runs while `cargo test` holds `target/`'s lock.
+pub fn develop_python_package(python: &Path) {
+    let venv = python.parent().and_then(|bin| bin.parent()).expect("TC_PYTHON is <venv>/bin/python");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let status = std::process::Command::new(python)
+        .args(["-m", "maturin", "develop", "--release", "--manifest-path"])
+        .arg(root.join("python/Cargo.toml"))
+        .env("VIRTUAL_ENV", venv)
+        .env("CARGO_TARGET_DIR", root.join("target").join("python"))
+        .status()
+        .expect("maturin (scripts/setup_venv.sh installs it)");
+    assert!(status.success(), "maturin develop failed");
 }
