@@ -306,6 +306,10 @@ fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
         json!({"publish": "attached_collision_object", "msg": attach}),
         json!({"wait_objects": ["crate", "on_table", "wall_plane"], "attached": ["tray"]}),
         states_step(),
+        // The cell markers show the scene in force, after the bursts of changes above (sent at
+        // most twice a second, the newest scene always): the sheet removed, attached objects
+        // not drawn.
+        json!({"markers": {"present": ["solids/crate", "solids/on_table", "cells/wall_plane"], "absent": ["cells/scan_sheet", "solids/tray"]}}),
         json!({"get": 128}),
     ];
 
@@ -338,6 +342,7 @@ fn the_planning_scene_as_moveit_keeps_it_live_and_replayed() {
     assert_eq!(results.len(), steps.len(), "{answer}");
     assert_eq!(answer3["results"][0], json!({"success": true}), "{answer3}");
     assert_eq!((&answer2["results"][1]["ok"], &answer2["results"][4]["ok"]), (&json!(true), &json!(true)), "{answer2}");
+    assert_eq!(answer2["results"][6]["ok"], true, "the cell markers show the scene in force: {}", answer2["results"][6]);
 
     // Each states step against its twin.
     let mut reported = Vec::new();

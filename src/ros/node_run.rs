@@ -18,6 +18,7 @@ use crate::pipeline::Pipeline;
 use anyhow::{anyhow, Context as _, Result};
 use futures::StreamExt;
 use ros2_client::{Context, Node, NodeName};
+use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -31,6 +32,12 @@ pub struct RunOptions {
 
 /// The loop's housekeeping period (`/rosout`, `/diagnostics`, the summary for a forced stop).
 const TICK: Duration = Duration::from_millis(100);
+
+/// The least time between two cell-marker messages sent for planning-scene changes. Each is up
+/// to 2.9 MB (`marker_max_cells`), fragmented and sent by the DDS thread that also receives the
+/// joint states: sent per change at 20 changes a second they raised the states' p99 by ~0.8 ms
+/// (`benches/run_scene_latency.sh`). The newest scene is always drawn, at most this late.
+const CELLS_GAP: Duration = Duration::from_millis(500);
 
 /// How long a stop request waits for the loop (busy building a robot, say) before the process
 /// exits without it: SIGTERM is honoured within 2 s whatever the loop is doing. (Exiting is not
@@ -194,6 +201,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
         checking: &checking,
         on_receive: &on_receive,
         changes: &changes,
+        cells: Cell::new(CellMarkers { stale: false, sent: None }),
     };
     running.serve(&stop, spinner, states_turns)?;
     // The interfaces go down on this thread, not the receiving one: a waker that took the state
@@ -221,6 +229,14 @@ struct Running<'a> {
     checking: &'a Arc<Mutex<Checking>>,
     on_receive: &'a Arc<OnReceive>,
     changes: &'a smol::channel::Receiver<Params>,
+    cells: Cell<CellMarkers>,
+}
+
+/// Whether the cell markers on the wire are behind the scene in force, and when the last went.
+#[derive(Clone, Copy)]
+struct CellMarkers {
+    stale: bool,
+    sent: Option<Instant>,
 }
 
 impl Running<'_> {
@@ -237,21 +253,34 @@ impl Running<'_> {
         }
     }
 
-    /// A scene change built and its cells drawn on the background thread, installed in between.
+    /// A scene change built on the background thread and installed here; its cells drawn now
+    /// or, within [`CELLS_GAP`] of the last drawing, at a later tick.
     async fn build_scene(&self, pending: PendingScene) {
         let built = self.background.run(move || pending.build()).await;
-        let cells = {
+        let installed = {
             let mut held = self.hold();
-            let cells = held.state.finish_scene(self.io, built);
+            let installed = held.state.finish_scene(self.io, built);
             self.rearm(&mut held);
-            cells
+            installed
         };
-        if let Some(cells) = cells {
-            // Drawn and serialised there too (milliseconds for a large scene).
-            let shared = Arc::clone(self.io);
-            if !self.background.run(move || cells.publish(&shared)).await {
-                self.hold().state.on_cells_failed(self.io);
-            }
+        if installed {
+            self.cells.set(CellMarkers { stale: true, ..self.cells.get() });
+            self.draw_cells_when_due().await;
+        }
+    }
+
+    /// The cell markers of the scene in force, drawn and serialised on the background thread
+    /// (milliseconds for a large scene), when they are stale and the gap has passed.
+    async fn draw_cells_when_due(&self) {
+        let CellMarkers { stale, sent } = self.cells.get();
+        if !stale || sent.is_some_and(|t| t.elapsed() < CELLS_GAP) {
+            return;
+        }
+        self.cells.set(CellMarkers { stale: false, sent: Some(Instant::now()) });
+        let cells = self.hold().state.cells_to_draw();
+        let shared = Arc::clone(self.io);
+        if !self.background.run(move || cells.publish(&shared)).await {
+            self.hold().state.on_cells_failed(self.io);
         }
     }
 
@@ -294,6 +323,7 @@ impl Running<'_> {
                 if std::mem::take(&mut tick_due) || last_tick.elapsed() >= TICK {
                     last_tick = Instant::now();
                     self.hold().state.on_tick(self.node, io);
+                    self.draw_cells_when_due().await;
                 }
                 // The tick never ends, so neither does this stream.
                 let Some(event) = events.next().await else { break };

@@ -127,7 +127,7 @@ impl NodeState {
             Event::ValidityDone(id, answer, reason) => self.send_validity_answer(io, id, answer, reason),
             // Prepared here, built without the state held, installed here (`node_run.rs`).
             Event::CollisionObject(_) | Event::AttachedObject(_) | Event::Scene(_) | Event::SceneWorld(_) | Event::ApplyScene(..) => {
-                if self.take_scene_event(io, event).and_then(|pending| self.finish_scene(io, pending.build())).is_some() {
+                if self.take_scene_event(io, event).is_some_and(|pending| self.finish_scene(io, pending.build())) {
                     self.publish_cells(io);
                 }
             }
@@ -382,16 +382,17 @@ impl NodeState {
 
     /// A built scene put in force, or its refusal warned about; an `apply_planning_scene`
     /// answered once the change is in force. The caller draws the cells it returns.
-    pub(super) fn finish_scene(&mut self, io: &Interfaces, built: BuiltPending) -> Option<CellsToDraw> {
+    /// True when the change is in force (its cell markers still to be sent).
+    pub(super) fn finish_scene(&mut self, io: &Interfaces, built: BuiltPending) -> bool {
         let installed = self.pipeline.install_scene(built.scene);
         // In force now: the caller waits for this answer, not for the markers.
         self.answer_apply(io, built.reply, installed.is_ok());
         self.refresh_summary();
         match installed {
-            Ok(()) => Some(self.cells_to_draw()),
+            Ok(()) => true,
             Err(skip) => {
                 self.warn_skip(&skip);
-                None
+                false
             }
         }
     }

@@ -32,6 +32,11 @@ stdin (live): {"op": "live", "domain": id, "ns": "" or "/ns", "timeout": s, "ste
                                                      {"success", "reply": s, "sent": n, "reports": [{"sent": s, "reported": s,
                                                      "objects": [...]}]}: apply_planning_scene called while the state is sent
                                                      every `period` (fresh stamps) until the reply; times from the request
+  {"markers": {"present": [ns...], "absent": [ns...]}, "timeout": s}
+                                                     {"ok": bool, "namespaces": [sorted ns of the newest array], "arrays": n}: the
+                                                     latched rt{ns}/collision_markers/cells (reliable, transient local, keep last 1)
+                                                     read until its newest MarkerArray has every "present" namespace and no "absent"
+                                                     one, up to `timeout` (default 10 s)
   {"sleep": s}                                       {}
 stdout (live): {"results": [...], "diagnostics": {key: value}} (the last value of each /diagnostics key, read until
   1.5 s after the last step).
@@ -92,6 +97,8 @@ def live(req):
     js_w = DataWriter(dp, Topic(dp, f"rt{ns}/joint_states", JointState), qos=sensor)
     reports_r = DataReader(dp, Topic(dp, f"rt{ns}/collisions", dds_types.CollisionReport), qos=reliable)
     diag_r = DataReader(dp, Topic(dp, "rt/diagnostics", dds_types.DiagnosticArray), qos=reliable)
+    latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+    cells_r = DataReader(dp, Topic(dp, f"rt{ns}/collision_markers/cells", dds_types.MarkerArray), qos=latched)
 
     def client(service, make):
         """A Cyclone-mapping service client (request writer, reply reader) for `service`."""
@@ -205,6 +212,22 @@ def live(req):
         return {"success": success, "reply": None if reply_at is None else reply_at - t0, "sent": len(sent),
                 "reports": [reports[st] for st in sorted(reports)]}
 
+    newest_cells = [None, 0]
+
+    def markers(s):
+        want, avoid = set(s["markers"].get("present", [])), set(s["markers"].get("absent", []))
+        end = time.time() + float(s.get("timeout", 10.0))
+        while True:
+            for m in cells_r.take(N=10):
+                if hasattr(m, "markers"):
+                    newest_cells[0] = sorted({mk.ns for mk in m.markers if mk.ns})
+                    newest_cells[1] += 1
+            seen = set(newest_cells[0] or [])
+            ok = newest_cells[0] is not None and want <= seen and not (avoid & seen)
+            if ok or time.time() >= end:
+                return {"ok": ok, "namespaces": newest_cells[0], "arrays": newest_cells[1]}
+            time.sleep(0.02)
+
     results = []
     for s in steps:
         if "publish" in s:
@@ -222,6 +245,8 @@ def live(req):
             results.append([state(x) for x in s["states"]])
         elif "apply_streaming" in s:
             results.append(apply_streaming(s))
+        elif "markers" in s:
+            results.append(markers(s))
         elif "sleep" in s:
             time.sleep(float(s["sleep"]))
             results.append({})
