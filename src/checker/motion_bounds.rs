@@ -3,7 +3,7 @@
 
 use super::link_targets::LinkTargets;
 use crate::collision::{ConvexHull, TargetShape};
-use crate::math::{Pose, Real, Vector};
+use crate::math::{pose_from_isometry, Pose, Real, Vector};
 use crate::model::{JointKind, RobotModel};
 use std::sync::{Arc, OnceLock};
 
@@ -22,6 +22,11 @@ const LEVELS: usize = 64 * RUNGS;
 pub(crate) struct MotionBounds {
     /// Per target (as `Checker::targets`): (joint index, lever in metres; 1 for prismatic).
     pub(super) levers: Vec<Vec<(usize, Real)>>,
+    /// Per target, per entry of `levers`: for a revolute joint whose child link is the target's
+    /// link or fixed to it, the farthest any of the target's points lies from the joint's axis
+    /// (the same in every configuration); else infinity. A link turning about its own long axis
+    /// (a forearm, a wrist) moves its points far less than its reach from the joint's origin.
+    pub(super) axis_reach: Vec<Vec<Real>>,
     /// Per target: the farthest any of its points lies from its link's origin.
     pub(super) reach: Vec<Real>,
     /// Per target: a point fixed to its link (link frame) and the farthest any of the target's
@@ -42,6 +47,17 @@ fn part_reach(shape: &TargetShape, offset: &Pose) -> Real {
         TargetShape::Cylinder { half_height, radius } => half_height.hypot(*radius),
     };
     offset.translation.length() + own
+}
+
+/// The farthest any point of a part (posed by `offset` in a frame) lies from the line through
+/// that frame's origin along unit `axis`: exact over a hull's points, else through the part's
+/// bounding ball.
+fn part_axis_reach(shape: &TargetShape, offset: &Pose, axis: Vector) -> Real {
+    let off_axis = |p: Vector| (p - axis * p.dot(axis)).length();
+    match shape {
+        TargetShape::Polytope(h) => h.points().iter().map(|p| off_axis(*offset * *p)).fold(0.0, Real::max),
+        _ => off_axis(*offset * shape.centre()) + shape.bounding_radius(),
+    }
 }
 
 /// A ball holding every part: the centre of the box around the parts' own bounding balls, and
@@ -77,6 +93,7 @@ pub(super) fn grow(shape: &TargetShape, pad: Real) -> TargetShape {
 impl MotionBounds {
     pub(crate) fn new(robot: &RobotModel, targets: &[LinkTargets], tolerance: Real) -> MotionBounds {
         let mut levers = Vec::with_capacity(targets.len());
+        let mut axis_reach = Vec::with_capacity(targets.len());
         let mut reaches = Vec::with_capacity(targets.len());
         for t in targets {
             let reach = t.parts.iter().map(|(s, o)| part_reach(s, o)).fold(0.0, Real::max);
@@ -85,15 +102,30 @@ impl MotionBounds {
             // origin of the joint reached so far, in any configuration.
             let mut chain = 0.0;
             let mut list = Vec::new();
+            let mut on_axis = Vec::new();
+            // The target's link frame in the frame of `link`, while only fixed joints lie between.
+            let mut rigid = Some(Pose::IDENTITY);
             let mut link = t.link;
             let mut steps = 0;
             while let Some(j) = robot.parent_joint(link) {
                 let joint = &robot.joints[j];
                 match joint.kind {
-                    JointKind::Revolute | JointKind::Continuous => list.push((j, chain + reach)),
-                    JointKind::Prismatic => list.push((j, 1.0)),
+                    JointKind::Revolute | JointKind::Continuous => {
+                        list.push((j, chain + reach));
+                        // The axis is fixed in the joint's child frame, which is `link`'s.
+                        let axis = Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
+                        on_axis.push(rigid.map_or(Real::INFINITY, |r| t.parts.iter().map(|(s, o)| part_axis_reach(s, &(r * *o), axis)).fold(0.0, Real::max)));
+                    }
+                    JointKind::Prismatic => {
+                        list.push((j, 1.0));
+                        on_axis.push(Real::INFINITY);
+                    }
                     JointKind::Fixed | JointKind::Floating | JointKind::Planar => {}
                 }
+                rigid = match joint.kind {
+                    JointKind::Fixed => rigid.map(|r| pose_from_isometry(&joint.origin) * r),
+                    _ => None,
+                };
                 chain += joint.origin.translation.vector.norm();
                 if joint.kind == JointKind::Prismatic {
                     chain += joint.limits[0].abs().max(joint.limits[1].abs());
@@ -105,10 +137,11 @@ impl MotionBounds {
                 }
             }
             levers.push(list);
+            axis_reach.push(on_axis);
         }
         let grown = targets.iter().map(|t| t.parts.iter().map(|_| (0..LEVELS).map(|_| OnceLock::new()).collect()).collect()).collect();
         let ball = targets.iter().map(|t| target_ball(&t.parts)).collect();
-        MotionBounds { levers, reach: reaches, ball, grown, base: tolerance / 2.0 }
+        MotionBounds { levers, axis_reach, reach: reaches, ball, grown, base: tolerance / 2.0 }
     }
 
     /// The ladder level whose growth covers `delta`.

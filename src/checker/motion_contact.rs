@@ -5,8 +5,8 @@ use super::checker::Checker;
 use super::motion_bounds::grow;
 use super::motion_sweep::Grown;
 use super::state_report::{ObjectType, ReportContact, StateReport};
-use crate::collision::{collide_pair, pair_may_meet, CollideSettings, PairContact, Target, TargetShape};
-use crate::math::Pose;
+use crate::collision::{collide_pair, pair_may_meet_grown, CollideSettings, PairContact, Target, TargetShape};
+use crate::math::{Pose, Real};
 
 impl Checker {
     /// Target `ti`'s part `pi` grown by ladder `level` (as it is for `None`).
@@ -29,15 +29,14 @@ impl Checker {
         })
     }
 
-    /// Whether any part of grown target `a` may meet any of `b` (see [`pair_may_meet`]).
-    pub(super) fn grown_pair_may_meet(&self, a: &Grown, b: &Grown) -> bool {
-        self.targets()[a.ti].parts.iter().enumerate().any(|(ia, (_, oa))| {
-            let part_a = Target::new(self.grown_part(a.ti, ia, a.level).clone(), a.pose * *oa);
-            self.targets()[b.ti]
-                .parts
-                .iter()
-                .enumerate()
-                .any(|(ib, (_, ob))| pair_may_meet(&part_a, &Target::new(self.grown_part(b.ti, ib, b.level).clone(), b.pose * *ob)))
+    /// Whether any part of target `a` grown by a ball of radius `delta_a` may meet any part of
+    /// `b` grown by `delta_b`, both as they are at their grown poses (see
+    /// [`pair_may_meet_grown`]).
+    pub(super) fn pair_may_meet_within(&self, a: &Grown, delta_a: Real, b: &Grown, delta_b: Real) -> bool {
+        let (ta, tb) = (&self.targets()[a.ti], &self.targets()[b.ti]);
+        ta.parts.iter().any(|(sa, oa)| {
+            let part_a = Target::new(sa.clone(), a.pose * *oa);
+            tb.parts.iter().any(|(sb, ob)| pair_may_meet_grown(&part_a, delta_a, &Target::new(sb.clone(), b.pose * *ob), delta_b))
         })
     }
 

@@ -289,7 +289,7 @@ impl Checker {
             return Ok(Stretch::Clear);
         }
         let (a, b) = (grown_for(bounds, ta, pa, delta_a, path.floor(ta)), grown_for(bounds, tb, pb, delta_b, path.floor(tb)));
-        Ok(Stretch::judge(start, a, Some(b), || self.grown_pair_may_meet(&a, &b)))
+        Ok(Stretch::judge(start, a, Some(b), || self.pair_may_meet_within(&a, delta_a.max(0.0), &b, delta_b.max(0.0))))
     }
 }
 

@@ -37,7 +37,7 @@ mod target_view;
 pub use self::cell_contact::{collide_target_cell, CellHit};
 pub use self::cell_tree::CellTree;
 pub use self::convex_hull::ConvexHull;
-pub(crate) use self::pair::{collide_pair, pair_may_meet, PairContact};
+pub(crate) use self::pair::{collide_pair, pair_may_meet_grown, PairContact};
 pub use self::report::{CollideSettings, Contact, LeastOverlap, TargetReport};
 pub use self::scene::{ObjectBody, Scene, SceneObject};
 pub use self::scene_clearance::Clearance;
