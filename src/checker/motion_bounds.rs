@@ -73,15 +73,16 @@ fn target_ball(parts: &[(TargetShape, Pose)]) -> (Vector, Real) {
     (centre, balls.iter().map(|(c, r)| (*c - centre).length() + r).fold(0.0, Real::max))
 }
 
-/// A superset of `shape ⊕ ball(pad)`: for a hull its Minkowski sum with a cube of half-side `pad`
-/// (which contains the ball); primitives grown in closed form.
+/// `shape ⊕ ball(pad)` or a superset: a hull as [`ConvexHull::grown_by_ball`] makes it (exact
+/// supports, the cube-grown polytope for the separating-axis test); primitives grown in closed
+/// form.
 pub(super) fn grow(shape: &TargetShape, pad: Real) -> TargetShape {
     match shape {
         TargetShape::Sphere { radius } => TargetShape::Sphere { radius: radius + pad },
         TargetShape::Capsule { half_height, radius } => TargetShape::Capsule { half_height: *half_height, radius: radius + pad },
         TargetShape::Cylinder { half_height, radius } => TargetShape::Cylinder { half_height: half_height + pad, radius: radius + pad },
         TargetShape::Polytope(h) => {
-            match ConvexHull::grown_by_cube(h, pad) {
+            match ConvexHull::grown_by_ball(h, pad) {
                 Some(g) => TargetShape::Polytope(Arc::new(g)),
                 // A ball around the hull contains it grown as well.
                 None => TargetShape::Sphere { radius: h.points().iter().map(|p| p.length()).fold(0.0, Real::max) + pad * 3f64.sqrt() },

@@ -48,11 +48,10 @@ pub struct ConvexHull {
     /// or more has no map and climbs from vertex 0.
     starts: Vec<u16>,
     parry: ConvexPolyhedron,
-    /// For a hull grown by a cube ([`ConvexHull::grown_by_cube`]): the hull it grew from and the
-    /// cube's half-side. Its extremes are that hull's plus the cube's (a Minkowski sum's support
-    /// is the sum of the supports), read from the smaller hull's cube map: one map per part stays
-    /// in cache, where each growth's own map (49 kB, a motion tests a part at a dozen growths)
-    /// missed it. The grown hull keeps its own faces and edges for the separating-axis test.
+    /// For a hull grown by a ball ([`ConvexHull::grown_by_ball`]): the hull it grew from and the
+    /// radius. Its extremes are that hull's plus the ball's (a Minkowski sum's support is the sum
+    /// of the supports), read from the smaller hull's cube map: one map per part stays in cache,
+    /// where each growth's own map (49 kB, a motion tests a part at a dozen growths) missed it.
     grown: Option<(Arc<ConvexHull>, Real)>,
 }
 
@@ -231,10 +230,14 @@ impl ConvexHull {
         Some(hull)
     }
 
-    /// The Minkowski sum of `core` and the cube `[-pad, pad]³` (which holds the ball of radius
-    /// `pad`): every vertex moved to each corner, hulled again. No cube map of its own: its
-    /// extremes are read from `core`'s.
-    pub(crate) fn grown_by_cube(core: &Arc<ConvexHull>, pad: Real) -> Option<ConvexHull> {
+    /// `core` grown by the ball of radius `pad`, as the motion check tests it. Its extremes and
+    /// support points are exactly the rounded shape's (`core`'s plus `pad·|d|`, from `core`'s cube
+    /// map); its own vertices, faces, edges and box are those of `core`'s Minkowski sum with the
+    /// cube `[-pad, pad]³`, which holds the rounded shape, for the separating-axis test: an axis
+    /// that separates that polytope separates the rounded shape too, and its box is the rounded
+    /// shape's. Growing by the cube alone reached √3 times as far along its corners, and the
+    /// motion check split stretches for contacts the displacement bound cannot reach.
+    pub(crate) fn grown_by_ball(core: &Arc<ConvexHull>, pad: Real) -> Option<ConvexHull> {
         let corners = cube_corners(Vector::splat(pad));
         let points: Vec<Vector> = core.points.iter().flat_map(|p| corners.iter().map(move |c| *p + *c)).collect();
         let mut grown = Self::hull_of(&points, false)?;
@@ -296,7 +299,7 @@ impl ConvexHull {
     /// `[min, max]` of `dir . x` over the hull.
     #[inline]
     pub(crate) fn project(&self, dir: Vector) -> [Real; 2] {
-        if self.points.len() >= CLIMB_MIN_POINTS {
+        if self.points.len() >= CLIMB_MIN_POINTS || self.grown.is_some() {
             return [-self.climb(-dir), self.climb(dir)];
         }
         crate::math::project_points(&self.points, dir)
@@ -310,7 +313,7 @@ impl ConvexHull {
     /// no neighbour improves on is the global maximum).
     fn climb(&self, dir: Vector) -> Real {
         if let Some((core, pad)) = &self.grown {
-            return core.extreme(dir) + pad * (dir.x.abs() + dir.y.abs() + dir.z.abs());
+            return core.extreme(dir) + pad * dir.length();
         }
         self.climb_vertex(dir).0
     }
@@ -318,7 +321,7 @@ impl ConvexHull {
     /// `max dir . x`, by climbing or, on a small hull, a scan.
     #[inline]
     pub(crate) fn extreme(&self, dir: Vector) -> Real {
-        if self.points.len() >= CLIMB_MIN_POINTS {
+        if self.points.len() >= CLIMB_MIN_POINTS || self.grown.is_some() {
             self.climb(dir)
         } else {
             crate::math::project_points(&self.points, dir)[1]
@@ -329,7 +332,7 @@ impl ConvexHull {
     /// most [`MANY`].
     #[inline]
     pub(crate) fn extremes(&self, dirs: &[Vector], out: &mut [Real]) {
-        if self.points.len() >= CLIMB_MIN_POINTS && dirs.len() <= MANY {
+        if (self.points.len() >= CLIMB_MIN_POINTS || self.grown.is_some()) && dirs.len() <= MANY {
             self.climb_many(dirs, out);
         } else {
             for (o, d) in out.iter_mut().zip(dirs) {
@@ -393,7 +396,7 @@ impl ConvexHull {
         if let Some((core, pad)) = &self.grown {
             core.extremes(dirs, out);
             for (o, d) in out.iter_mut().zip(dirs) {
-                *o += pad * (d.x.abs() + d.y.abs() + d.z.abs());
+                *o += pad * d.length();
             }
             return;
         }
@@ -410,7 +413,9 @@ impl ConvexHull {
     #[inline]
     pub(crate) fn support_point(&self, dir: Vector) -> Vector {
         if let Some((core, pad)) = &self.grown {
-            return core.support_point(dir) + Vector::new(pad.copysign(dir.x), pad.copysign(dir.y), pad.copysign(dir.z));
+            let length = dir.length();
+            let out = if length > 0.0 { dir * (pad / length) } else { Vector::ZERO };
+            return core.support_point(dir) + out;
         }
         if self.points.len() >= CLIMB_MIN_POINTS {
             return self.points[self.climb_vertex(dir).1];
@@ -432,10 +437,12 @@ mod tests {
     use super::*;
     use crate::collision::target::TargetShape;
 
-    /// A grown hull answers its extremes from the hull it grew from: over random hulls, growths
-    /// and directions, every answer equals the maximum over the grown hull's own vertices.
+    /// A grown hull answers the extremes of the hull it grew from grown by the ball: over random
+    /// hulls, growths and directions, every answer is `core`'s plus `pad·|d|`, no more than its own
+    /// (cube-grown) vertices reach, at least what the core's vertices pushed `pad` along `d`
+    /// reach (points of the rounded shape), and its box is the rounded shape's.
     #[test]
-    fn a_grown_hull_has_the_extremes_of_its_own_vertices() {
+    fn a_grown_hull_has_the_extremes_of_the_rounded_hull() {
         let mut rng = oorandom::Rand64::new(5);
         let mut unit = || 2.0 * rng.rand_float() - 1.0;
         let mut checked = 0;
@@ -445,19 +452,24 @@ mod tests {
             let points: Vec<Vector> = (0..n).map(|_| Vector::new(unit() * 0.3, unit() * 0.1, unit() * 0.05)).collect();
             let core = Arc::new(ConvexHull::from_points(&points).unwrap());
             let pad = [0.0005, 0.02, 0.3][case % 3];
-            let grown = ConvexHull::grown_by_cube(&core, pad).unwrap();
+            let grown = ConvexHull::grown_by_ball(&core, pad).unwrap();
             assert!(grown.grown.is_some());
+            for k in 0..3 {
+                assert!((grown.aabb.mins[k] - (core.aabb.mins[k] - pad)).abs() < 1e-12 && (grown.aabb.maxs[k] - (core.aabb.maxs[k] + pad)).abs() < 1e-12);
+            }
             let dirs: Vec<Vector> = (0..MANY).map(|_| Vector::new(unit(), unit(), unit())).collect();
             let mut many = [0.0; MANY];
             TargetShape::Polytope(Arc::new(grown.clone())).support_many(&dirs, &mut many);
             for (d, m) in dirs.iter().zip(many) {
+                let rounded = |d: Vector| core.points.iter().map(|p| d.dot(*p)).fold(Real::NEG_INFINITY, Real::max) + pad * d.length();
                 let own = grown.points.iter().map(|p| d.dot(*p)).fold(Real::NEG_INFINITY, Real::max);
-                let tol = 1e-12 * (1.0 + own.abs());
-                assert!((grown.project(*d)[1] - own).abs() < tol, "project {d:?}");
-                assert!((d.dot(grown.support_point(*d)) - own).abs() < tol, "support_point {d:?}");
-                assert!((m - own).abs() < tol, "support_many {d:?}: {m} against {own}");
-                let low = grown.points.iter().map(|p| d.dot(*p)).fold(Real::INFINITY, Real::min);
-                assert!((grown.project(*d)[0] - low).abs() < tol, "project's low end {d:?}");
+                let want = rounded(*d);
+                let tol = 1e-12 * (1.0 + want.abs());
+                assert!(want <= own + tol, "the cube-grown vertices hold the rounded hull along {d:?}");
+                assert!((grown.project(*d)[1] - want).abs() < tol, "project {d:?}");
+                assert!((d.dot(grown.support_point(*d)) - want).abs() < tol, "support_point {d:?}");
+                assert!((m - want).abs() < tol, "support_many {d:?}: {m} against {want}");
+                assert!((grown.project(*d)[0] + rounded(-*d)).abs() < tol, "project's low end {d:?}");
                 checked += 1;
             }
         }
