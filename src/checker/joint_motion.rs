@@ -19,8 +19,10 @@
 use super::checker::Checker;
 use super::motion_sweep::{MotionPath, MotionReport};
 use super::state_report::StateReport;
+use super::stretch_keys::StretchMap;
 use crate::math::{pose_from_isometry, Pose, Real, Vector};
 use crate::model::{JointKind, RobotModel};
+use std::cell::RefCell;
 
 /// A motion in joint space: `q0 + s·delta`, link poses by forward kinematics.
 struct JointPath<'a> {
@@ -31,6 +33,21 @@ struct JointPath<'a> {
     /// Per target: a bound on the acceleration of any of its points along `s` (see
     /// `point_acceleration`).
     accelerations: Vec<Real>,
+    /// The bounds found per target and stretch: every target, and every self pair it belongs
+    /// to, asks at the same dyadic stretches (see [`Levered`]).
+    levered: RefCell<StretchMap<(usize, u64, u64), Levered>>,
+}
+
+/// Bounds kept at most per motion (cleared past this, as the sweep's poses are).
+const MAX_CACHED_BOUNDS: usize = 4096;
+
+/// What one pass over a target's joints gives at a stretch's middle: the world bound (the
+/// smaller of the lever sum and the first-order bound), and the lever sums of its nearest
+/// joints, `prefix[k]` over the first `k` (times the half-width). A self pair's relative bound
+/// is such a prefix: the joints a pair's two links share are the end of each one's list.
+struct Levered {
+    world: Real,
+    prefix: Vec<Real>,
 }
 
 /// A bound on `|d²p/ds²|` over every point `p` of a target and every `s`, for the levers of its
@@ -70,8 +87,9 @@ pub(super) fn axis_and_offset(joint: &crate::model::JointModel, child: &Pose, li
 
 /// What the joints below a target do to it at the middle of a stretch (see `JointPath::bound`).
 struct Moved {
-    /// `Σ_j |Δq_j| · lever_j`, each lever tightened at the middle.
-    levers: Real,
+    /// `Σ_j |Δq_j| · lever_j` over the first `k` joints (nearest first), each lever tightened at
+    /// the middle; the last is the whole sum.
+    prefix: Vec<Real>,
     /// The link's angular velocity, and the velocity of the point given.
     omega: Vector,
     velocity: Vector,
@@ -84,13 +102,12 @@ impl JointPath<'_> {
         self.q0.iter().zip(&self.delta).map(|(a, d)| a + s * d).collect()
     }
 
-    /// Target `ti`'s joints, nearest first, up to the first that `shared` names (the joints above
-    /// it move the other target of a pair too, and so the pair as one body): the lever sum, each
-    /// lever the smaller of its bound over all configurations and the distance from the axis to
-    /// the link's origin at the middle, plus the link's reach, plus what the joints between can
+    /// Target `ti`'s joints, nearest first: the lever sums over the first `k` of them, each lever
+    /// the smaller of its bound over all configurations and the distance from the axis to the
+    /// link's origin at the middle, plus the link's reach, plus what the joints between can
     /// change that within `half`; and the velocities at the middle, of the link's rotation and
     /// of the point `c`.
-    fn levers_at(&self, ti: usize, link: Pose, c: Vector, poses: &[Option<Pose>], half: f64, shared: impl Fn(usize) -> bool) -> Moved {
+    fn levers_at(&self, ti: usize, link: Pose, c: Vector, poses: &[Option<Pose>], half: f64) -> Moved {
         let robot = self.checker.robot();
         let bounds = self.checker.motion_bounds();
         let reach = bounds.reach[ti];
@@ -98,8 +115,11 @@ impl JointPath<'_> {
         let centre = link * centre;
         // Σ_i |Δq_i| r_ik over the joints between the current one and the link.
         let mut below = 0.0;
-        let mut moved = Moved { levers: 0.0, omega: Vector::ZERO, velocity: Vector::ZERO, first_order: true };
-        for (&(j, r), &on_axis) in bounds.levers[ti].iter().zip(&bounds.axis_reach[ti]).take_while(|((j, _), _)| !shared(*j)) {
+        let mut prefix = Vec::with_capacity(bounds.levers[ti].len() + 1);
+        prefix.push(0.0);
+        let mut moved = Moved { prefix: Vec::new(), omega: Vector::ZERO, velocity: Vector::ZERO, first_order: true };
+        let mut sum = 0.0;
+        for (&(j, r), &on_axis) in bounds.levers[ti].iter().zip(&bounds.axis_reach[ti]) {
             let d = self.delta[j].abs();
             let joint = &robot.joints[j];
             // Either constant: the lever over all configurations, or the distance from the axis
@@ -125,10 +145,45 @@ impl JointPath<'_> {
                     r
                 }
             };
-            moved.levers += d * lever;
+            sum += d * lever;
+            prefix.push(sum);
             below += d * r;
         }
+        moved.prefix = prefix;
         moved
+    }
+
+    /// The bounds of target `ti` on the stretch of half-width `half` about `mid` (`poses` there),
+    /// found once and kept for the pairs that ask again.
+    fn ensure_levered(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) {
+        let key = (ti, mid.to_bits(), half.to_bits());
+        if self.levered.borrow().contains_key(&key) {
+            return;
+        }
+        let found = self.find_levered(ti, poses, half);
+        let mut kept = self.levered.borrow_mut();
+        if kept.len() >= MAX_CACHED_BOUNDS {
+            kept.clear();
+        }
+        let _ = kept.insert(key, found);
+    }
+
+    /// [`Levered`] for target `ti`: see [`JointPath::bound`].
+    fn find_levered(&self, ti: usize, poses: &[Option<Pose>], half: f64) -> Levered {
+        let Some(link) = poses[self.checker.targets()[ti].link] else {
+            let whole = half * self.speeds[ti];
+            return Levered { world: whole, prefix: vec![whole; self.checker.motion_bounds().levers[ti].len() + 1] };
+        };
+        let (centre, radius) = self.checker.motion_bounds().ball[ti];
+        let moved = self.levers_at(ti, link, link * centre, poses, half);
+        let prefix: Vec<Real> = moved.prefix.iter().map(|p| half * p).collect();
+        let levers = prefix.last().copied().unwrap_or(0.0);
+        if !moved.first_order {
+            return Levered { world: levers, prefix };
+        }
+        let moving = half * (moved.velocity.length() + moved.omega.length() * radius) + 0.5 * half * half * self.accelerations[ti];
+        // NaN (a bad pose) falls back to the lever bound.
+        Levered { world: if moving < levers { moving } else { levers }, prefix }
     }
 }
 
@@ -153,21 +208,9 @@ impl MotionPath for JointPath<'_> {
     /// about a point `c` of the link, plus what it can gain within `half`: every point moves at
     /// most `half · (|v_c| + |ω| R) + half² · A / 2` from where it is at `s`, with `A` the
     /// acceleration bound of `point_acceleration`. The smaller of the two bounds is used.
-    fn bound(&self, ti: usize, poses: &[Option<Pose>], _mid: f64, half: f64) -> Real {
-        let Some(link) = poses[self.checker.targets()[ti].link] else { return half * self.speeds[ti] };
-        let (centre, radius) = self.checker.motion_bounds().ball[ti];
-        let moved = self.levers_at(ti, link, link * centre, poses, half, |_| false);
-        let levers = half * moved.levers;
-        if !moved.first_order {
-            return levers;
-        }
-        let moving = half * (moved.velocity.length() + moved.omega.length() * radius) + 0.5 * half * half * self.accelerations[ti];
-        // NaN (a bad pose) falls back to the lever bound.
-        if moving < levers {
-            moving
-        } else {
-            levers
-        }
+    fn bound(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
+        self.ensure_levered(ti, poses, mid, half);
+        self.levered.borrow()[&(ti, mid.to_bits(), half.to_bits())].world
     }
 
     fn out_of_limits(&self, s: f64) -> Vec<String> {
@@ -183,17 +226,18 @@ impl MotionPath for JointPath<'_> {
     /// tightened at the middle as for `bound`; the world bounds when those are smaller in sum.
     fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> (Real, Real) {
         let targets = self.checker.targets();
-        let relative = match (poses[targets[a].link], poses[targets[b].link]) {
-            (Some(pa), Some(pb)) => {
-                let levers = &self.checker.motion_bounds().levers;
-                let own = |x: usize, y: usize, pose: Pose| {
-                    half * self.levers_at(x, pose, pose.translation, poses, half, |j| levers[y].iter().any(|(k, _)| *k == j)).levers
-                };
-                (own(a, b, pa), own(b, a, pb))
-            }
-            _ => self.pair_bound_quick(a, b, poses, mid, half),
-        };
-        let world = (self.bound(a, poses, mid, half), self.bound(b, poses, mid, half));
+        if poses[targets[a].link].is_none() || poses[targets[b].link].is_none() {
+            return self.pair_bound_quick(a, b, poses, mid, half);
+        }
+        self.ensure_levered(a, poses, mid, half);
+        self.ensure_levered(b, poses, mid, half);
+        let kept = self.levered.borrow();
+        let (la, lb) = (&kept[&(a, mid.to_bits(), half.to_bits())], &kept[&(b, mid.to_bits(), half.to_bits())]);
+        let levers = &self.checker.motion_bounds().levers;
+        // The joints of `x` up to the first that moves `y` too.
+        let own = |x: usize, y: usize| levers[x].iter().take_while(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).count();
+        let relative = (la.prefix[own(a, b)], lb.prefix[own(b, a)]);
+        let world = (la.world, lb.world);
         if relative.0 + relative.1 <= world.0 + world.1 {
             relative
         } else {
@@ -267,7 +311,7 @@ impl Checker {
             .map(|(l, on_axis)| l.iter().zip(on_axis).map(|((j, r), a)| delta[*j].abs() * r.min(*a)).sum())
             .collect();
         let accelerations = bounds.levers.iter().zip(&speeds).map(|(l, speed)| point_acceleration(robot, l, &delta, *speed)).collect();
-        Ok(JointPath { checker: self, q0, delta, speeds, accelerations })
+        Ok(JointPath { checker: self, q0, delta, speeds, accelerations, levered: RefCell::new(StretchMap::default()) })
     }
 }
 

@@ -24,6 +24,7 @@ mod spline_clearance;
 mod spline_poly;
 mod state_check;
 mod state_report;
+mod stretch_keys;
 #[cfg(test)]
 mod test_points;
 mod world_motion;

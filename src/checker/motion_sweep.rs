@@ -7,9 +7,10 @@
 use super::checker::Checker;
 use super::motion_bounds::MotionBounds;
 use super::state_report::StateReport;
+use super::stretch_keys::StretchMap;
 use crate::collision::CollideSettings;
 use crate::math::{Pose, Real};
-use std::collections::hash_map::{Entry, HashMap};
+use std::collections::hash_map::Entry;
 
 /// Sub-intervals examined at most per motion; past that the motion fails closed.
 pub(crate) const MAX_SUBINTERVALS: u64 = 1 << 20;
@@ -149,7 +150,7 @@ fn grown_for(bounds: &MotionBounds, ti: usize, pose: Pose, delta: Real, floor: R
 /// The state of one sweep: the link poses by `s` (the targets of one link chain meet at the same
 /// midpoints), the earliest stretch blocked so far, and the stretches examined.
 struct Sweep {
-    poses_at: HashMap<u64, Vec<Option<Pose>>>,
+    poses_at: StretchMap<u64, Vec<Option<Pose>>>,
     blocked: Option<Blocked>,
     examined: u64,
     stack: Vec<(f64, f64)>,
@@ -203,7 +204,7 @@ impl Checker {
     pub(super) fn sweep_motion(&self, path: &impl MotionPath) -> MotionReport {
         let targets = (0..self.targets().len()).map(Swept::Target);
         let pairs = self.self_pairs().pairs.iter().map(|&(a, b)| Swept::Pair(a, b));
-        let mut sweep = Sweep { poses_at: HashMap::new(), blocked: None, examined: 0, stack: Vec::with_capacity(64) };
+        let mut sweep = Sweep { poses_at: StretchMap::default(), blocked: None, examined: 0, stack: Vec::with_capacity(64) };
         let run = targets.chain(pairs).try_for_each(|swept| {
             sweep.clear(path, |poses, start, half| match swept {
                 Swept::Target(ti) => self.judge_target(path, ti, poses, start, half),
