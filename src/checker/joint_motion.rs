@@ -355,6 +355,12 @@ mod tests {
     /// The bound the adaptive loop trusts, checked directly: over random motions of the bundled
     /// arm (revolute, continuous, prismatic and mimic joints), no point of any link, sampled
     /// along a stretch, lies farther from where it is at the stretch's middle than the bound.
+    /// Every joint within its limits (continuous ones within one turn), drawn by `draw(lo, hi)`.
+    fn random_state(robot: &RobotModel, draw: &mut impl FnMut(f64, f64) -> f64) -> Vec<f64> {
+        let pi = std::f64::consts::PI;
+        robot.joints.iter().map(|j| if j.limits.iter().all(|l| l.is_finite()) { draw(j.limits[0], j.limits[1]) } else { draw(-pi, pi) }).collect()
+    }
+
     /// The self pairs' bound, checked directly: within a stretch, no distance between a point of
     /// one link of a pair and a point of the other changes by more than the two bounds' sum (so
     /// two links grown by them at the middle, apart, stay apart), over random motions of the
@@ -368,13 +374,7 @@ mod tests {
         let (mut checked, mut tightest) = (0usize, 0.0f64);
         let points: Vec<Vec<Vector>> = c.targets().iter().map(|t| t.parts.iter().flat_map(|(shape, offset)| part_points(shape, offset)).collect()).collect();
         for k in 0..200 {
-            let mut qs = [vec![0.0; robot.joints.len()], vec![0.0; robot.joints.len()]];
-            for q in &mut qs {
-                for (i, j) in robot.joints.iter().enumerate() {
-                    let [lo, hi] = j.limits;
-                    q[i] = if lo.is_finite() && hi.is_finite() { draw(lo, hi) } else { draw(-std::f64::consts::PI, std::f64::consts::PI) };
-                }
-            }
+            let qs = [random_state(robot, &mut draw), random_state(robot, &mut draw)];
             let path = c.joint_path(&qs[0], &qs[1]).unwrap();
             let half = [0.5, 0.2, 0.05, 0.01][k % 4];
             let s = draw(0.0, 1.0);
@@ -412,13 +412,7 @@ mod tests {
         let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
         let (mut checked, mut tightest) = (0usize, 0.0f64);
         for _ in 0..400 {
-            let mut qs = [vec![0.0; robot.joints.len()], vec![0.0; robot.joints.len()]];
-            for q in &mut qs {
-                for (i, j) in robot.joints.iter().enumerate() {
-                    let [lo, hi] = j.limits;
-                    q[i] = if lo.is_finite() && hi.is_finite() { draw(lo, hi) } else { draw(-std::f64::consts::PI, std::f64::consts::PI) };
-                }
-            }
+            let qs = [random_state(robot, &mut draw), random_state(robot, &mut draw)];
             let path = c.joint_path(&qs[0], &qs[1]).unwrap();
             let half = [0.5, 0.2, 0.05, 0.01][checked % 4];
             let s = draw(0.0, 1.0);
