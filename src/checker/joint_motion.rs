@@ -90,7 +90,7 @@ struct Moved {
     /// `Σ_j |Δq_j| · lever_j` over the first `k` joints (nearest first), each lever tightened at
     /// the middle; the last is the whole sum.
     prefix: Vec<Real>,
-    /// The link's angular velocity, and the velocity of the point given.
+    /// The link's angular velocity, and the velocity of the centre of its ball.
     omega: Vector,
     velocity: Vector,
     /// Every joint that moves was posed (else only the lever sum holds).
@@ -103,11 +103,11 @@ impl JointPath<'_> {
     }
 
     /// Target `ti`'s joints, nearest first: the lever sums over the first `k` of them, each lever
-    /// the smaller of its bound over all configurations and the distance from the axis to the
-    /// link's origin at the middle, plus the link's reach, plus what the joints between can
-    /// change that within `half`; and the velocities at the middle, of the link's rotation and
-    /// of the point `c`.
-    fn levers_at(&self, ti: usize, link: Pose, c: Vector, poses: &[Option<Pose>], half: f64) -> Moved {
+    /// the smaller of its steady bound and the distance from the axis to the link's origin (or
+    /// its ball's centre) at the middle, plus the link's reach (or the ball's radius), plus what
+    /// the joints between can change that within `half`; and the velocities at the middle, of the
+    /// link's rotation and of its ball's centre.
+    fn levers_at(&self, ti: usize, link: Pose, poses: &[Option<Pose>], half: f64) -> Moved {
         let robot = self.checker.robot();
         let bounds = self.checker.motion_bounds();
         let reach = bounds.reach[ti];
@@ -115,21 +115,17 @@ impl JointPath<'_> {
         let centre = link * centre;
         // Σ_i |Δq_i| r_ik over the joints between the current one and the link.
         let mut below = 0.0;
-        let mut prefix = Vec::with_capacity(bounds.levers[ti].len() + 1);
-        prefix.push(0.0);
-        let mut moved = Moved { prefix: Vec::new(), omega: Vector::ZERO, velocity: Vector::ZERO, first_order: true };
+        let mut moved = Moved { prefix: Vec::with_capacity(bounds.levers[ti].len() + 1), omega: Vector::ZERO, velocity: Vector::ZERO, first_order: true };
+        moved.prefix.push(0.0);
         let mut sum = 0.0;
-        for (&(j, r), &on_axis) in bounds.levers[ti].iter().zip(&bounds.axis_reach[ti]) {
+        for (&(j, _), &r) in bounds.levers[ti].iter().zip(&bounds.steady[ti]) {
             let d = self.delta[j].abs();
             let joint = &robot.joints[j];
-            // Either constant: the lever over all configurations, or the distance from the axis
-            // of a joint the link is fixed to.
-            let r = r.min(on_axis);
             let lever = match (joint.kind, poses[joint.child]) {
                 (JointKind::Revolute | JointKind::Continuous, Some(child)) => {
                     let (axis, off_axis) = axis_and_offset(joint, &child, &link);
                     moved.omega += axis * self.delta[j];
-                    moved.velocity += axis.cross(c - child.translation) * self.delta[j];
+                    moved.velocity += axis.cross(centre - child.translation) * self.delta[j];
                     // From the axis to the link's origin plus its reach, or to its ball's centre
                     // plus the ball's radius: both hold every point of the link at the middle.
                     let to_centre = centre - child.translation;
@@ -146,26 +142,27 @@ impl JointPath<'_> {
                 }
             };
             sum += d * lever;
-            prefix.push(sum);
+            moved.prefix.push(sum);
             below += d * r;
         }
-        moved.prefix = prefix;
         moved
     }
 
     /// The bounds of target `ti` on the stretch of half-width `half` about `mid` (`poses` there),
-    /// found once and kept for the pairs that ask again.
-    fn ensure_levered(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) {
+    /// found once and kept for the pairs that ask again; its world bound.
+    fn ensure_levered(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
         let key = (ti, mid.to_bits(), half.to_bits());
-        if self.levered.borrow().contains_key(&key) {
-            return;
+        if let Some(kept) = self.levered.borrow().get(&key) {
+            return kept.world;
         }
         let found = self.find_levered(ti, poses, half);
+        let world = found.world;
         let mut kept = self.levered.borrow_mut();
         if kept.len() >= MAX_CACHED_BOUNDS {
             kept.clear();
         }
         let _ = kept.insert(key, found);
+        world
     }
 
     /// [`Levered`] for target `ti`: see [`JointPath::bound`].
@@ -174,9 +171,10 @@ impl JointPath<'_> {
             let whole = half * self.speeds[ti];
             return Levered { world: whole, prefix: vec![whole; self.checker.motion_bounds().levers[ti].len() + 1] };
         };
-        let (centre, radius) = self.checker.motion_bounds().ball[ti];
-        let moved = self.levers_at(ti, link, link * centre, poses, half);
-        let prefix: Vec<Real> = moved.prefix.iter().map(|p| half * p).collect();
+        let radius = self.checker.motion_bounds().ball[ti].1;
+        let moved = self.levers_at(ti, link, poses, half);
+        let mut prefix = moved.prefix;
+        prefix.iter_mut().for_each(|p| *p *= half);
         let levers = prefix.last().copied().unwrap_or(0.0);
         if !moved.first_order {
             return Levered { world: levers, prefix };
@@ -209,8 +207,7 @@ impl MotionPath for JointPath<'_> {
     /// most `half · (|v_c| + |ω| R) + half² · A / 2` from where it is at `s`, with `A` the
     /// acceleration bound of `point_acceleration`. The smaller of the two bounds is used.
     fn bound(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
-        self.ensure_levered(ti, poses, mid, half);
-        self.levered.borrow()[&(ti, mid.to_bits(), half.to_bits())].world
+        self.ensure_levered(ti, poses, mid, half)
     }
 
     fn out_of_limits(&self, s: f64) -> Vec<String> {
@@ -229,14 +226,11 @@ impl MotionPath for JointPath<'_> {
         if poses[targets[a].link].is_none() || poses[targets[b].link].is_none() {
             return self.pair_bound_quick(a, b, poses, mid, half);
         }
-        self.ensure_levered(a, poses, mid, half);
-        self.ensure_levered(b, poses, mid, half);
+        let _ = (self.ensure_levered(a, poses, mid, half), self.ensure_levered(b, poses, mid, half));
         let kept = self.levered.borrow();
         let (la, lb) = (&kept[&(a, mid.to_bits(), half.to_bits())], &kept[&(b, mid.to_bits(), half.to_bits())]);
-        let levers = &self.checker.motion_bounds().levers;
-        // The joints of `x` up to the first that moves `y` too.
-        let own = |x: usize, y: usize| levers[x].iter().take_while(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).count();
-        let relative = (la.prefix[own(a, b)], lb.prefix[own(b, a)]);
+        let bounds = self.checker.motion_bounds();
+        let relative = (la.prefix[bounds.unshared(a, b)], lb.prefix[bounds.unshared(b, a)]);
         let world = (la.world, lb.world);
         if relative.0 + relative.1 <= world.0 + world.1 {
             relative
@@ -248,14 +242,8 @@ impl MotionPath for JointPath<'_> {
     /// The relative bounds of [`JointPath::pair_bound`] alone.
     fn pair_bound_quick(&self, a: usize, b: usize, _poses: &[Option<Pose>], _mid: f64, half: f64) -> (Real, Real) {
         let bounds = self.checker.motion_bounds();
-        let levers = &bounds.levers;
         let own = |x: usize, y: usize| -> Real {
-            levers[x]
-                .iter()
-                .zip(&bounds.axis_reach[x])
-                .filter(|((j, _), _)| !levers[y].iter().any(|(k, _)| k == j))
-                .map(|((j, r), on_axis)| self.delta[*j].abs() * r.min(*on_axis))
-                .sum()
+            bounds.levers[x].iter().zip(&bounds.steady[x]).take(bounds.unshared(x, y)).map(|((j, _), r)| self.delta[*j].abs() * r).sum()
         };
         (half * own(a, b), half * own(b, a))
     }
@@ -302,14 +290,10 @@ impl Checker {
             }
         }
         let bounds = self.motion_bounds();
-        // Per target: Σ_j |Δq_j| r_jk (each lever the smaller of its two constant bounds), the
-        // speed bound of its points per unit of s.
-        let speeds: Vec<Real> = bounds
-            .levers
-            .iter()
-            .zip(&bounds.axis_reach)
-            .map(|(l, on_axis)| l.iter().zip(on_axis).map(|((j, r), a)| delta[*j].abs() * r.min(*a)).sum())
-            .collect();
+        // Per target: Σ_j |Δq_j| r_jk (the steady levers), the speed bound of its points per
+        // unit of s.
+        let speeds: Vec<Real> =
+            bounds.levers.iter().zip(&bounds.steady).map(|(l, steady)| l.iter().zip(steady).map(|((j, _), r)| delta[*j].abs() * r).sum()).collect();
         let accelerations = bounds.levers.iter().zip(&speeds).map(|(l, speed)| point_acceleration(robot, l, &delta, *speed)).collect();
         Ok(JointPath { checker: self, q0, delta, speeds, accelerations, levered: RefCell::new(StretchMap::default()) })
     }

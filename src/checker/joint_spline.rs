@@ -78,8 +78,7 @@ impl SplinePath<'_> {
 
     /// Per joint that moves target `ti` and not target `other`, the sum of excursion times lever.
     fn own(&self, x: usize, y: usize, e: &[f64]) -> Real {
-        let levers = &self.levers;
-        levers[x].iter().filter(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).map(|(j, r)| e[*j] * r).sum()
+        self.levers[x].iter().take(self.checker.motion_bounds().unshared(x, y)).map(|(j, r)| e[*j] * r).sum()
     }
 
     fn bound_with(&self, ti: usize, poses: &[Option<Pose>], e: &[f64]) -> Real {

@@ -22,11 +22,14 @@ const LEVELS: usize = 64 * RUNGS;
 pub(crate) struct MotionBounds {
     /// Per target (as `Checker::targets`): (joint index, lever in metres; 1 for prismatic).
     pub(super) levers: Vec<Vec<(usize, Real)>>,
-    /// Per target, per entry of `levers`: for a revolute joint whose child link is the target's
-    /// link or fixed to it, the farthest any of the target's points lies from the joint's axis
-    /// (the same in every configuration); else infinity. A link turning about its own long axis
-    /// (a forearm, a wrist) moves its points far less than its reach from the joint's origin.
-    pub(super) axis_reach: Vec<Vec<Real>>,
+    /// Per target, per entry of `levers`: the lever that bounds how fast the joint moves the
+    /// target's points in every configuration. For a revolute joint whose child link is the
+    /// target's link or fixed to it, the smaller of `levers`' and the farthest any of the
+    /// target's points lies from the joint's axis (the same in every configuration: a link
+    /// turning about its own long axis, a forearm or a wrist, moves its points far less than its
+    /// reach from the joint's origin); else `levers`'. (`levers` itself bounds the distance from
+    /// the joint's origin, which `point_acceleration` needs.)
+    pub(super) steady: Vec<Vec<Real>>,
     /// Per target: the farthest any of its points lies from its link's origin.
     pub(super) reach: Vec<Real>,
     /// Per target: a point fixed to its link (link frame) and the farthest any of the target's
@@ -94,7 +97,7 @@ pub(super) fn grow(shape: &TargetShape, pad: Real) -> TargetShape {
 impl MotionBounds {
     pub(crate) fn new(robot: &RobotModel, targets: &[LinkTargets], tolerance: Real) -> MotionBounds {
         let mut levers = Vec::with_capacity(targets.len());
-        let mut axis_reach = Vec::with_capacity(targets.len());
+        let mut steady = Vec::with_capacity(targets.len());
         let mut reaches = Vec::with_capacity(targets.len());
         for t in targets {
             let reach = t.parts.iter().map(|(s, o)| part_reach(s, o)).fold(0.0, Real::max);
@@ -103,7 +106,7 @@ impl MotionBounds {
             // origin of the joint reached so far, in any configuration.
             let mut chain = 0.0;
             let mut list = Vec::new();
-            let mut on_axis = Vec::new();
+            let mut speeds = Vec::new();
             // The target's link frame in the frame of `link`, while only fixed joints lie between.
             let mut rigid = Some(Pose::IDENTITY);
             let mut link = t.link;
@@ -115,11 +118,12 @@ impl MotionBounds {
                         list.push((j, chain + reach));
                         // The axis is fixed in the joint's child frame, which is `link`'s.
                         let axis = Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
-                        on_axis.push(rigid.map_or(Real::INFINITY, |r| t.parts.iter().map(|(s, o)| part_axis_reach(s, &(r * *o), axis)).fold(0.0, Real::max)));
+                        let on_axis = rigid.map_or(Real::INFINITY, |r| t.parts.iter().map(|(s, o)| part_axis_reach(s, &(r * *o), axis)).fold(0.0, Real::max));
+                        speeds.push((chain + reach).min(on_axis));
                     }
                     JointKind::Prismatic => {
                         list.push((j, 1.0));
-                        on_axis.push(Real::INFINITY);
+                        speeds.push(1.0);
                     }
                     JointKind::Fixed | JointKind::Floating | JointKind::Planar => {}
                 }
@@ -138,11 +142,18 @@ impl MotionBounds {
                 }
             }
             levers.push(list);
-            axis_reach.push(on_axis);
+            steady.push(speeds);
         }
         let grown = targets.iter().map(|t| t.parts.iter().map(|_| (0..LEVELS).map(|_| OnceLock::new()).collect()).collect()).collect();
         let ball = targets.iter().map(|t| target_ball(&t.parts)).collect();
-        MotionBounds { levers, axis_reach, reach: reaches, ball, grown, base: tolerance / 2.0 }
+        MotionBounds { levers, steady, reach: reaches, ball, grown, base: tolerance / 2.0 }
+    }
+
+    /// How many of target `x`'s joints (nearest first) come before the first that moves target
+    /// `y` too: the joints a pair's two links share are the end of each one's list, and they move
+    /// the pair as one body.
+    pub(super) fn unshared(&self, x: usize, y: usize) -> usize {
+        self.levers[x].iter().take_while(|(j, _)| !self.levers[y].iter().any(|(k, _)| k == j)).count()
     }
 
     /// The ladder level whose growth covers `delta`.

@@ -381,8 +381,8 @@ impl NodeState {
     }
 
     /// A built scene put in force, or its refusal warned about; an `apply_planning_scene`
-    /// answered once the change is in force. The caller draws the cells it returns.
-    /// True when the change is in force (its cell markers still to be sent).
+    /// answered once the change is in force. True when it is (its cell markers still to be
+    /// sent: the caller draws them).
     pub(super) fn finish_scene(&mut self, io: &Interfaces, built: BuiltPending) -> bool {
         let installed = self.pipeline.install_scene(built.scene);
         // In force now: the caller waits for this answer, not for the markers.
