@@ -7,10 +7,8 @@
 use super::checker::Checker;
 use super::motion_bounds::MotionBounds;
 use super::state_report::StateReport;
-use super::stretch_keys::StretchMap;
 use crate::collision::CollideSettings;
 use crate::math::{Pose, Real};
-use std::collections::hash_map::Entry;
 
 /// Sub-intervals examined at most per motion; past that the motion fails closed.
 pub(crate) const MAX_SUBINTERVALS: u64 = 1 << 20;
@@ -23,10 +21,6 @@ pub(crate) const MAX_SUBINTERVALS: u64 = 1 << 20;
 /// 0.3, 0.15, 0.08, 0.06, 0.04, 0.02 m gave 4.51, 4.22, 4.08, 4.06, 4.03, 4.20 state checks per
 /// motion on the peer world and 7.19, 6.57, 6.41, 6.40, 6.47, 7.22 on the wall (10,000 motions).
 const MAX_TESTED_GROWTH: Real = 0.06;
-
-/// Link poses kept for reuse at most (cleared past this): a motion that needs millions of
-/// midpoints must not keep a pose set for each.
-const MAX_CACHED_POSES: usize = 4096;
 
 /// What a motion check gives.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -78,13 +72,6 @@ pub(super) trait MotionPath {
     }
 }
 
-/// What one run of the loop clears: a target against the environment, or a self pair.
-#[derive(Clone, Copy)]
-enum Swept {
-    Target(usize),
-    Pair(usize, usize),
-}
-
 /// A target grown for one stretch: its ladder level (`None`: as it is), whether that growth is
 /// worth testing, and its link's pose at the stretch's middle.
 #[derive(Clone, Copy)]
@@ -110,8 +97,9 @@ struct Blocked {
 enum Stretch {
     /// Nothing can be met on it.
     Clear,
-    /// Not cleared at this size: try its halves.
-    Split,
+    /// Not cleared at this size: try its halves. `met`: the grown test was made and met
+    /// something (else the growth was too large to be worth testing).
+    Split { met: bool },
     /// Not cleared and not worth splitting: the motion is blocked from the stretch's start.
     Blocked(Blocked),
 }
@@ -127,7 +115,7 @@ impl Stretch {
         } else if all(|g| g.settled) {
             Stretch::Blocked(Blocked { fraction: start, grown, other })
         } else {
-            Stretch::Split
+            Stretch::Split { met: all(|g| g.tested) }
         }
     }
 }
@@ -147,77 +135,85 @@ fn grown_for(bounds: &MotionBounds, ti: usize, pose: Pose, delta: Real, floor: R
     }
 }
 
-/// The state of one sweep: the link poses by `s` (the targets of one link chain meet at the same
-/// midpoints), the earliest stretch blocked so far, and the stretches examined.
-struct Sweep {
-    poses_at: StretchMap<u64, Vec<Option<Pose>>>,
-    blocked: Option<Blocked>,
-    examined: u64,
-    stack: Vec<(f64, f64)>,
-}
-
-impl Sweep {
-    /// Clears `[0, limit)` by bisection, left half first, where `limit` is the earliest stretch
-    /// blocked so far; `test` judges a stretch from the link poses at its middle, its start and
-    /// its half-width.
-    fn clear(&mut self, path: &impl MotionPath, mut test: impl FnMut(&[Option<Pose>], f64, f64) -> Result<Stretch, String>) -> Result<(), String> {
-        self.stack.clear();
-        self.stack.push((0.0, 1.0));
-        while let Some((a, b)) = self.stack.pop() {
-            let limit = self.blocked.as_ref().map_or(f64::INFINITY, |b| b.fraction);
-            if a >= limit {
-                continue;
-            }
-            self.examined += 1;
-            if self.examined > MAX_SUBINTERVALS {
-                return Err(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"));
-            }
-            let m = 0.5 * (a + b);
-            if self.poses_at.len() >= MAX_CACHED_POSES {
-                self.poses_at.clear();
-            }
-            let poses = match self.poses_at.entry(m.to_bits()) {
-                Entry::Occupied(e) => e.into_mut(),
-                Entry::Vacant(e) => e.insert(path.link_poses(m)?),
-            };
-            match test(poses, a, 0.5 * (b - a))? {
-                Stretch::Clear => {}
-                Stretch::Split => {
-                    self.stack.push((m, b));
-                    self.stack.push((a, m));
-                }
-                Stretch::Blocked(blocked) => {
-                    self.blocked = Some(blocked);
-                    return Ok(());
-                }
-            }
-        }
-        Ok(())
-    }
+/// A stretch waiting to be examined: its ends, and where the targets and pairs it must still
+/// clear are in the sweep's member list (see [`Checker::sweep_motion`]).
+struct Pending {
+    a: f64,
+    b: f64,
+    members: std::ops::Range<usize>,
 }
 
 impl Checker {
-    /// The adaptive loop over `path` (see the module documentation of `joint_motion`). Targets,
-    /// then self pairs, are cleared one after the other, each over `[0, limit)`, where `limit` is
-    /// the earliest stretch that an earlier one could not clear: the answer is the earliest over
-    /// all, as if they were examined together, left half first.
+    /// The adaptive loop over `path` (see the module documentation of `joint_motion`): every
+    /// target against the environment and every self pair, examined together by bisection, left
+    /// half first; a stretch is split with only what it did not clear. A stretch is examined
+    /// after every stretch that starts before it, so the first one blocked is the earliest of
+    /// all, and nothing past it is examined (a motion that collides early costs what its start
+    /// costs).
     pub(super) fn sweep_motion(&self, path: &impl MotionPath) -> MotionReport {
-        let targets = (0..self.targets().len()).map(Swept::Target);
-        let pairs = self.self_pairs().pairs.iter().map(|&(a, b)| Swept::Pair(a, b));
-        let mut sweep = Sweep { poses_at: StretchMap::default(), blocked: None, examined: 0, stack: Vec::with_capacity(64) };
-        let run = targets.chain(pairs).try_for_each(|swept| {
-            sweep.clear(path, |poses, start, half| match swept {
-                Swept::Target(ti) => self.judge_target(path, ti, poses, start, half),
-                Swept::Pair(ta, tb) => self.judge_pair(path, ta, tb, poses, start, half),
-            })
-        });
+        let targets = self.targets().len();
+        let pairs = &self.self_pairs().pairs;
+        // One list for every pending stretch: a stretch's survivors are appended after its own
+        // members, and both halves share them. The stack is last in, first out, so when a stretch
+        // is taken, whatever follows its members belongs to stretches already done.
+        let mut members: Vec<u32> = (0..(targets + pairs.len()) as u32).collect();
+        let mut stack = Vec::with_capacity(64);
+        stack.push(Pending { a: 0.0, b: 1.0, members: 0..members.len() });
+        let mut examined = 0u64;
+        let mut blocked: Option<Blocked> = None;
+        let mut probed = vec![false; members.len()];
+        let mut start_poses = None;
+        let run = (|| -> Result<(), String> {
+            while let Some(Pending { a, b, members: mine }) = stack.pop() {
+                members.truncate(mine.end);
+                let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+                let poses = path.link_poses(mid)?;
+                let survivors = members.len();
+                for k in mine {
+                    examined += 1;
+                    if examined > MAX_SUBINTERVALS {
+                        return Err(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"));
+                    }
+                    let i = members[k] as usize;
+                    let verdict = match pairs.get(i.wrapping_sub(targets)) {
+                        Some(&(ta, tb)) if i >= targets => self.judge_pair(path, ta, tb, &poses, a, half)?,
+                        _ => self.judge_target(path, i, &poses, a, half)?,
+                    };
+                    match verdict {
+                        Stretch::Clear => {}
+                        Stretch::Split { met } => {
+                            // Near something at the motion's start: if it is there already, the
+                            // motion is blocked at 0 (the earliest there is) without descending
+                            // to the tolerance. Asked once per target or pair.
+                            if met && a == 0.0 && !probed[i] {
+                                probed[i] = true;
+                                if let Some(found) = self.blocked_at_start(path, i, &mut start_poses)? {
+                                    blocked = Some(found);
+                                    return Ok(());
+                                }
+                            }
+                            members.push(i as u32);
+                        }
+                        Stretch::Blocked(found) => {
+                            blocked = Some(found);
+                            return Ok(());
+                        }
+                    }
+                }
+                if members.len() > survivors {
+                    let split = survivors..members.len();
+                    stack.push(Pending { a: mid, b, members: split.clone() });
+                    stack.push(Pending { a, b: mid, members: split });
+                }
+            }
+            Ok(())
+        })();
         if let Err(error) = run {
             let mut report = StateReport::failed(error);
             report.motion = true;
-            return MotionReport { report, fraction: None, subintervals: sweep.examined };
+            return MotionReport { report, fraction: None, subintervals: examined };
         }
-        let examined = sweep.examined;
-        match sweep.blocked {
+        match blocked {
             None => {
                 // A free motion stands for its end pose: the clearances are that pose's.
                 let clearances = if self.params().clearance_threshold > 0.0 { path.report_at(1.0).clearances } else { Vec::new() };
@@ -232,6 +228,34 @@ impl Checker {
                 blocked_report(report, b.fraction, examined)
             }
         }
+    }
+
+    /// Whether member `i` of the sweep (a target, then the self pairs) meets something, as it
+    /// is, at the motion's start: then the motion is blocked there. `poses` keeps the start's
+    /// link poses for the next member asked.
+    fn blocked_at_start(&self, path: &impl MotionPath, i: usize, poses: &mut Option<Vec<Option<Pose>>>) -> Result<Option<Blocked>, String> {
+        let poses = match poses {
+            Some(p) => p,
+            None => poses.insert(path.link_poses(0.0)?),
+        };
+        let targets = self.targets().len();
+        let at = |ti: usize| -> Result<Grown, String> {
+            let lt = &self.targets()[ti];
+            let pose = poses[lt.link].ok_or_else(|| format!("no pose for link '{}'", lt.name))?;
+            Ok(Grown { ti, level: None, tested: true, settled: true, pose })
+        };
+        let found = match self.self_pairs().pairs.get(i.wrapping_sub(targets)) {
+            Some(&(ta, tb)) if i >= targets => {
+                let (a, b) = (at(ta)?, at(tb)?);
+                self.pair_may_meet_within(&a, 0.0, &b, 0.0).then_some(Blocked { fraction: 0.0, grown: a, other: Some(b) })
+            }
+            _ => {
+                let g = at(i)?;
+                let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
+                self.grown_link_hit(&g, &flags).then_some(Blocked { fraction: 0.0, grown: g, other: None })
+            }
+        };
+        Ok(found)
     }
 
     /// The report of the state where the motion is blocked: only the blocked target or pair is
