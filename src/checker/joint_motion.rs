@@ -19,7 +19,6 @@
 use super::checker::Checker;
 use super::motion_sweep::{MotionPath, MotionReport};
 use super::state_report::StateReport;
-use super::stretch_keys::StretchMap;
 use crate::math::{pose_from_isometry, Pose, Real, Vector};
 use crate::model::{JointKind, RobotModel};
 use std::cell::RefCell;
@@ -33,19 +32,24 @@ struct JointPath<'a> {
     /// Per target: a bound on the acceleration of any of its points along `s` (see
     /// `point_acceleration`).
     accelerations: Vec<Real>,
-    /// The bounds found per target and stretch: every target, and every self pair it belongs
-    /// to, asks at the same dyadic stretches (see [`Levered`]).
-    levered: RefCell<StretchMap<(usize, u64, u64), Levered>>,
+    /// Per target: `Σ_j |Δq_j| r_j` over its first `k` joints (nearest first, the steady
+    /// levers) at `[k]`; the last is its speed. A self pair's quick relative bound is such a
+    /// prefix times the half-width.
+    steady_sums: Vec<Vec<Real>>,
+    /// Per target, the bounds last found for it (see [`Levered`]): the sweep examines a
+    /// stretch's targets and pairs together, so a pair asks at the stretch its targets just
+    /// answered.
+    levered: RefCell<Vec<Levered>>,
 }
-
-/// Bounds kept at most per motion (cleared past this, as the sweep's poses are).
-const MAX_CACHED_BOUNDS: usize = 4096;
 
 /// What one pass over a target's joints gives at a stretch's middle: the world bound (the
 /// smaller of the lever sum and the first-order bound), and the lever sums of its nearest
 /// joints, `prefix[k]` over the first `k` (times the half-width). A self pair's relative bound
 /// is such a prefix: the joints a pair's two links share are the end of each one's list.
+#[derive(Default)]
 struct Levered {
+    /// The stretch they are for: the bits of its middle and half-width (`None`: none yet).
+    stretch: Option<(u64, u64)>,
     world: Real,
     prefix: Vec<Real>,
 }
@@ -87,9 +91,6 @@ pub(super) fn axis_and_offset(joint: &crate::model::JointModel, child: &Pose, li
 
 /// What the joints below a target do to it at the middle of a stretch (see `JointPath::bound`).
 struct Moved {
-    /// `Σ_j |Δq_j| · lever_j` over the first `k` joints (nearest first), each lever tightened at
-    /// the middle; the last is the whole sum.
-    prefix: Vec<Real>,
     /// The link's angular velocity, and the velocity of the centre of its ball.
     omega: Vector,
     velocity: Vector,
@@ -107,7 +108,9 @@ impl JointPath<'_> {
     /// its ball's centre) at the middle, plus the link's reach (or the ball's radius), plus what
     /// the joints between can change that within `half`; and the velocities at the middle, of the
     /// link's rotation and of its ball's centre.
-    fn levers_at(&self, ti: usize, link: Pose, poses: &[Option<Pose>], half: f64) -> Moved {
+    /// `prefix` gets `Σ_j |Δq_j| · lever_j` over the first `k` joints at `[k]`; the last is the
+    /// whole sum.
+    fn levers_at(&self, ti: usize, link: Pose, poses: &[Option<Pose>], half: f64, prefix: &mut Vec<Real>) -> Moved {
         let robot = self.checker.robot();
         let bounds = self.checker.motion_bounds();
         let reach = bounds.reach[ti];
@@ -115,8 +118,9 @@ impl JointPath<'_> {
         let centre = link * centre;
         // Σ_i |Δq_i| r_ik over the joints between the current one and the link.
         let mut below = 0.0;
-        let mut moved = Moved { prefix: Vec::with_capacity(bounds.levers[ti].len() + 1), omega: Vector::ZERO, velocity: Vector::ZERO, first_order: true };
-        moved.prefix.push(0.0);
+        let mut moved = Moved { omega: Vector::ZERO, velocity: Vector::ZERO, first_order: true };
+        prefix.clear();
+        prefix.push(0.0);
         let mut sum = 0.0;
         for (&(j, _), &r) in bounds.levers[ti].iter().zip(&bounds.steady[ti]) {
             let d = self.delta[j].abs();
@@ -142,7 +146,7 @@ impl JointPath<'_> {
                 }
             };
             sum += d * lever;
-            moved.prefix.push(sum);
+            prefix.push(sum);
             below += d * r;
         }
         moved
@@ -151,37 +155,39 @@ impl JointPath<'_> {
     /// The bounds of target `ti` on the stretch of half-width `half` about `mid` (`poses` there),
     /// found once and kept for the pairs that ask again; its world bound.
     fn ensure_levered(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
-        let key = (ti, mid.to_bits(), half.to_bits());
-        if let Some(kept) = self.levered.borrow().get(&key) {
-            return kept.world;
-        }
-        let found = self.find_levered(ti, poses, half);
-        let world = found.world;
+        let stretch = Some((mid.to_bits(), half.to_bits()));
         let mut kept = self.levered.borrow_mut();
-        if kept.len() >= MAX_CACHED_BOUNDS {
-            kept.clear();
+        let slot = &mut kept[ti];
+        if slot.stretch != stretch {
+            slot.stretch = stretch;
+            slot.world = self.find_levered(ti, poses, half, &mut slot.prefix);
         }
-        let _ = kept.insert(key, found);
-        world
+        slot.world
     }
 
-    /// [`Levered`] for target `ti`: see [`JointPath::bound`].
-    fn find_levered(&self, ti: usize, poses: &[Option<Pose>], half: f64) -> Levered {
+    /// [`Levered`] for target `ti` into `prefix`, returning the world bound: see
+    /// [`JointPath::bound`].
+    fn find_levered(&self, ti: usize, poses: &[Option<Pose>], half: f64, prefix: &mut Vec<Real>) -> Real {
         let Some(link) = poses[self.checker.targets()[ti].link] else {
             let whole = half * self.speeds[ti];
-            return Levered { world: whole, prefix: vec![whole; self.checker.motion_bounds().levers[ti].len() + 1] };
+            prefix.clear();
+            prefix.resize(self.checker.motion_bounds().levers[ti].len() + 1, whole);
+            return whole;
         };
         let radius = self.checker.motion_bounds().ball[ti].1;
-        let moved = self.levers_at(ti, link, poses, half);
-        let mut prefix = moved.prefix;
+        let moved = self.levers_at(ti, link, poses, half, prefix);
         prefix.iter_mut().for_each(|p| *p *= half);
         let levers = prefix.last().copied().unwrap_or(0.0);
         if !moved.first_order {
-            return Levered { world: levers, prefix };
+            return levers;
         }
         let moving = half * (moved.velocity.length() + moved.omega.length() * radius) + 0.5 * half * half * self.accelerations[ti];
         // NaN (a bad pose) falls back to the lever bound.
-        Levered { world: if moving < levers { moving } else { levers }, prefix }
+        if moving < levers {
+            moving
+        } else {
+            levers
+        }
     }
 }
 
@@ -228,7 +234,7 @@ impl MotionPath for JointPath<'_> {
         }
         let _ = (self.ensure_levered(a, poses, mid, half), self.ensure_levered(b, poses, mid, half));
         let kept = self.levered.borrow();
-        let (la, lb) = (&kept[&(a, mid.to_bits(), half.to_bits())], &kept[&(b, mid.to_bits(), half.to_bits())]);
+        let (la, lb) = (&kept[a], &kept[b]);
         let bounds = self.checker.motion_bounds();
         let relative = (la.prefix[bounds.unshared(a, b)], lb.prefix[bounds.unshared(b, a)]);
         let world = (la.world, lb.world);
@@ -242,10 +248,7 @@ impl MotionPath for JointPath<'_> {
     /// The relative bounds of [`JointPath::pair_bound`] alone.
     fn pair_bound_quick(&self, a: usize, b: usize, _poses: &[Option<Pose>], _mid: f64, half: f64) -> (Real, Real) {
         let bounds = self.checker.motion_bounds();
-        let own = |x: usize, y: usize| -> Real {
-            bounds.levers[x].iter().zip(&bounds.steady[x]).take(bounds.unshared(x, y)).map(|((j, _), r)| self.delta[*j].abs() * r).sum()
-        };
-        (half * own(a, b), half * own(b, a))
+        (half * self.steady_sums[a][bounds.unshared(a, b)], half * self.steady_sums[b][bounds.unshared(b, a)])
     }
 }
 
@@ -292,10 +295,23 @@ impl Checker {
         let bounds = self.motion_bounds();
         // Per target: Σ_j |Δq_j| r_jk (the steady levers), the speed bound of its points per
         // unit of s.
-        let speeds: Vec<Real> =
-            bounds.levers.iter().zip(&bounds.steady).map(|(l, steady)| l.iter().zip(steady).map(|((j, _), r)| delta[*j].abs() * r).sum()).collect();
+        let steady_sums: Vec<Vec<Real>> = bounds
+            .levers
+            .iter()
+            .zip(&bounds.steady)
+            .map(|(l, steady)| {
+                std::iter::once(0.0)
+                    .chain(l.iter().zip(steady).scan(0.0, |sum, ((j, _), r)| {
+                        *sum += delta[*j].abs() * r;
+                        Some(*sum)
+                    }))
+                    .collect()
+            })
+            .collect();
+        let speeds: Vec<Real> = steady_sums.iter().map(|sums| sums.last().copied().unwrap_or(0.0)).collect();
         let accelerations = bounds.levers.iter().zip(&speeds).map(|(l, speed)| point_acceleration(robot, l, &delta, *speed)).collect();
-        Ok(JointPath { checker: self, q0, delta, speeds, accelerations, levered: RefCell::new(StretchMap::default()) })
+        let levered = RefCell::new((0..speeds.len()).map(|_| Levered::default()).collect());
+        Ok(JointPath { checker: self, q0, delta, speeds, accelerations, steady_sums, levered })
     }
 }
 

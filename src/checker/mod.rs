@@ -24,7 +24,6 @@ mod spline_clearance;
 mod spline_poly;
 mod state_check;
 mod state_report;
-mod stretch_keys;
 #[cfg(test)]
 mod test_points;
 mod world_motion;

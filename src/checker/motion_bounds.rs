@@ -37,6 +37,8 @@ pub(crate) struct MotionBounds {
     pub(super) ball: Vec<(Vector, Real)>,
     /// Per target, per part, per level: the part grown by `base · 2^level`.
     pub(super) grown: Vec<Vec<Vec<OnceLock<TargetShape>>>>,
+    /// Per pair of targets `(x, y)`, at `x * targets + y`: see [`MotionBounds::unshared`].
+    unshared: Vec<usize>,
     /// Growth of level 0: half the tolerance, so a level under the tolerance exists.
     base: Real,
 }
@@ -146,14 +148,21 @@ impl MotionBounds {
         }
         let grown = targets.iter().map(|t| t.parts.iter().map(|_| (0..LEVELS).map(|_| OnceLock::new()).collect()).collect()).collect();
         let ball = targets.iter().map(|t| target_ball(&t.parts)).collect();
-        MotionBounds { levers, steady, reach: reaches, ball, grown, base: tolerance / 2.0 }
+        let n = levers.len();
+        let unshared = (0..n * n)
+            .map(|xy| {
+                let (x, y): (usize, usize) = (xy / n, xy % n);
+                levers[x].iter().take_while(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).count()
+            })
+            .collect();
+        MotionBounds { levers, steady, reach: reaches, ball, grown, unshared, base: tolerance / 2.0 }
     }
 
     /// How many of target `x`'s joints (nearest first) come before the first that moves target
     /// `y` too: the joints a pair's two links share are the end of each one's list, and they move
     /// the pair as one body.
     pub(super) fn unshared(&self, x: usize, y: usize) -> usize {
-        self.levers[x].iter().take_while(|(j, _)| !self.levers[y].iter().any(|(k, _)| k == j)).count()
+        self.unshared[x * self.levers.len() + y]
     }
 
     /// The ladder level whose growth covers `delta`.
