@@ -6,7 +6,7 @@ use super::motion_bounds::grow;
 use super::motion_sweep::Grown;
 use super::state_report::{ObjectType, ReportContact, StateReport};
 use crate::collision::{collide_pair, pair_may_meet_grown, CollideSettings, PairContact, Target, TargetShape};
-use crate::math::{Pose, Real};
+use crate::math::{Pose, Real, Vector};
 
 impl Checker {
     /// Target `ti`'s part `pi` grown by ladder `level` (as it is for `None`).
@@ -32,11 +32,13 @@ impl Checker {
     /// Whether any part of target `a` grown by a ball of radius `delta_a` may meet any part of
     /// `b` grown by `delta_b`, both as they are at their grown poses (see
     /// [`pair_may_meet_grown`]).
-    pub(super) fn pair_may_meet_within(&self, a: &Grown, delta_a: Real, b: &Grown, delta_b: Real) -> bool {
+    /// `hint`: where the search starts and the separating axis found (see
+    /// [`pair_may_meet_grown`]), shared by the pair's parts.
+    pub(super) fn pair_may_meet_within(&self, a: &Grown, delta_a: Real, b: &Grown, delta_b: Real, hint: &mut Vector) -> bool {
         let (ta, tb) = (&self.targets()[a.ti], &self.targets()[b.ti]);
         ta.parts.iter().any(|(sa, oa)| {
             let part_a = Target::new(sa.clone(), a.pose * *oa);
-            tb.parts.iter().any(|(sb, ob)| pair_may_meet_grown(&part_a, delta_a, &Target::new(sb.clone(), b.pose * *ob), delta_b))
+            tb.parts.iter().any(|(sb, ob)| pair_may_meet_grown(&part_a, delta_a, &Target::new(sb.clone(), b.pose * *ob), delta_b, hint))
         })
     }
 

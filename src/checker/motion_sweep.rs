@@ -8,7 +8,7 @@ use super::checker::Checker;
 use super::motion_bounds::MotionBounds;
 use super::state_report::StateReport;
 use crate::collision::CollideSettings;
-use crate::math::{Pose, Real};
+use crate::math::{Pose, Real, Vector};
 
 /// Sub-intervals examined at most per motion; past that the motion fails closed.
 pub(crate) const MAX_SUBINTERVALS: u64 = 1 << 20;
@@ -162,6 +162,7 @@ impl Checker {
         let mut examined = 0u64;
         let mut blocked: Option<Blocked> = None;
         let mut probed = vec![false; members.len()];
+        let mut hints = vec![Vector::ZERO; pairs.len()];
         let mut start_poses = None;
         let run = (|| -> Result<(), String> {
             while let Some(Pending { a, b, members: mine }) = stack.pop() {
@@ -176,7 +177,7 @@ impl Checker {
                     }
                     let i = members[k] as usize;
                     let verdict = match pairs.get(i.wrapping_sub(targets)) {
-                        Some(&(ta, tb)) if i >= targets => self.judge_pair(path, ta, tb, &poses, a, half)?,
+                        Some(&(ta, tb)) if i >= targets => self.judge_pair(path, ta, tb, &poses, a, half, &mut hints[i - targets])?,
                         _ => self.judge_target(path, i, &poses, a, half)?,
                     };
                     match verdict {
@@ -247,7 +248,8 @@ impl Checker {
         let found = match self.self_pairs().pairs.get(i.wrapping_sub(targets)) {
             Some(&(ta, tb)) if i >= targets => {
                 let (a, b) = (at(ta)?, at(tb)?);
-                self.pair_may_meet_within(&a, 0.0, &b, 0.0).then_some(Blocked { fraction: 0.0, grown: a, other: Some(b) })
+                let mut hint = Vector::ZERO;
+                self.pair_may_meet_within(&a, 0.0, &b, 0.0, &mut hint).then_some(Blocked { fraction: 0.0, grown: a, other: Some(b) })
             }
             _ => {
                 let g = at(i)?;
@@ -296,7 +298,18 @@ impl Checker {
 
     /// A stretch of self pair `(ta, tb)`: cleared when its two links at the middle, each grown by
     /// its own displacement bound, do not meet (then they stay apart all along the stretch).
-    fn judge_pair(&self, path: &impl MotionPath, ta: usize, tb: usize, poses: &[Option<Pose>], start: f64, half: f64) -> Result<Stretch, String> {
+    /// `hint`: the axis that last separated the pair, in the first link's frame (see
+    /// [`crate::collision::pair_may_meet_grown`]).
+    fn judge_pair(
+        &self,
+        path: &impl MotionPath,
+        ta: usize,
+        tb: usize,
+        poses: &[Option<Pose>],
+        start: f64,
+        half: f64,
+        hint: &mut Vector,
+    ) -> Result<Stretch, String> {
         let (la, lb) = (&self.targets()[ta], &self.targets()[tb]);
         let (Some(pa), Some(pb)) = (poses[la.link], poses[lb.link]) else {
             return Err(format!("no pose for link '{}' or '{}'", la.name, lb.name));
@@ -316,7 +329,7 @@ impl Checker {
             return Ok(Stretch::Clear);
         }
         let (a, b) = (grown_for(bounds, ta, pa, delta_a, path.floor(ta)), grown_for(bounds, tb, pb, delta_b, path.floor(tb)));
-        Ok(Stretch::judge(start, a, Some(b), || self.pair_may_meet_within(&a, delta_a.max(0.0), &b, delta_b.max(0.0))))
+        Ok(Stretch::judge(start, a, Some(b), || self.pair_may_meet_within(&a, delta_a.max(0.0), &b, delta_b.max(0.0), hint)))
     }
 }
 
