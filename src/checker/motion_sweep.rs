@@ -183,10 +183,13 @@ impl Checker {
                     match verdict {
                         Stretch::Clear => {}
                         Stretch::Split { met } => {
-                            // Near something at the motion's start: if it is there already, the
+                            // Perhaps meeting something at the motion's start: if it does, the
                             // motion is blocked at 0 (the earliest there is) without descending
-                            // to the tolerance. Asked once per target or pair.
-                            if met && a == 0.0 && !probed[i] {
+                            // to the tolerance. Asked once per target or pair: a target as soon
+                            // as it is not cleared (its ball at the start first), a pair once
+                            // its grown test has met something (a pair's test is cheap, but
+                            // near pairs are many).
+                            if a == 0.0 && !probed[i] && (met || i < targets) {
                                 probed[i] = true;
                                 if let Some(found) = self.blocked_at_start(path, i, &mut start_poses)? {
                                     blocked = Some(found);
@@ -253,8 +256,10 @@ impl Checker {
             }
             _ => {
                 let g = at(i)?;
+                let (centre, radius) = self.motion_bounds().ball[i];
                 let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
-                self.grown_link_hit(&g, &flags).then_some(Blocked { fraction: 0.0, grown: g, other: None })
+                let near = !self.scene().ball_is_clear(g.pose * centre, radius, |oi| !self.allowed[i][oi]);
+                (near && self.grown_link_hit(&g, &flags)).then_some(Blocked { fraction: 0.0, grown: g, other: None })
             }
         };
         Ok(found)
