@@ -441,6 +441,25 @@ mod tests {
         eprintln!("{checked} stretches, largest motion / bound {tightest:.3}");
     }
 
+    /// A motion that starts in collision is blocked at 0 with the start state's own report, found
+    /// at the first stretch (every target and pair examined once at most), not by descending to
+    /// the tolerance; the same motion from a free start is not.
+    #[test]
+    fn a_motion_from_a_colliding_start_is_blocked_there_at_once() {
+        let c = arm();
+        let into = q(&c, &[("shoulder_lift_joint", 1.2), ("elbow_joint", 0.3)]);
+        let free = q(&c, &[]);
+        let start = c.check_positions(&into).unwrap();
+        assert!(start.in_collision);
+        let r = c.check_motion(&into, &free);
+        assert_eq!(r.fraction, Some(0.0), "{r:?}");
+        assert_eq!(r.report.contacts, start.contacts);
+        let members = (c.targets().len() + c.self_pairs().pairs.len()) as u64;
+        assert!(r.subintervals <= members, "{} stretches examined, {members} targets and pairs", r.subintervals);
+        let back = c.check_motion(&free, &into);
+        assert!(back.fraction.unwrap() > 0.0 && back.subintervals > members, "{back:?}");
+    }
+
     #[test]
     fn a_crossing_between_free_states_is_found_and_a_free_motion_is_free() {
         let c = arm();
