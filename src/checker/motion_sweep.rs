@@ -7,7 +7,7 @@
 use super::checker::Checker;
 use super::motion_bounds::MotionBounds;
 use super::state_report::StateReport;
-use crate::collision::CollideSettings;
+use crate::collision::{BallWitness, CollideSettings};
 use crate::math::{Pose, Real, Vector};
 
 /// Sub-intervals examined at most per motion; past that the motion fails closed.
@@ -163,6 +163,7 @@ impl Checker {
         let mut blocked: Option<Blocked> = None;
         let mut probed = vec![false; members.len()];
         let mut hints = vec![Vector::ZERO; pairs.len()];
+        let mut witnesses = vec![None; targets];
         let mut start_poses = None;
         let run = (|| -> Result<(), String> {
             while let Some(Pending { a, b, members: mine }) = stack.pop() {
@@ -178,7 +179,7 @@ impl Checker {
                     let i = members[k] as usize;
                     let verdict = match pairs.get(i.wrapping_sub(targets)) {
                         Some(&(ta, tb)) if i >= targets => self.judge_pair(path, ta, tb, &poses, a, half, &mut hints[i - targets])?,
-                        _ => self.judge_target(path, i, &poses, a, half)?,
+                        _ => self.judge_target(path, i, &poses, a, half, &mut witnesses[i])?,
                     };
                     match verdict {
                         Stretch::Clear => {}
@@ -284,7 +285,17 @@ impl Checker {
     }
 
     /// A stretch of target `ti` against the environment.
-    fn judge_target(&self, path: &impl MotionPath, ti: usize, poses: &[Option<Pose>], start: f64, half: f64) -> Result<Stretch, String> {
+    /// `witness`: a cell's box found within the target's ball at an earlier stretch (see
+    /// [`crate::collision::BallWitness`]): a target near a surface is mostly still near it.
+    fn judge_target(
+        &self,
+        path: &impl MotionPath,
+        ti: usize,
+        poses: &[Option<Pose>],
+        start: f64,
+        half: f64,
+        witness: &mut Option<BallWitness>,
+    ) -> Result<Stretch, String> {
         let lt = &self.targets()[ti];
         let pose = poses[lt.link].ok_or_else(|| format!("no pose for link '{}'", lt.name))?;
         // A link that does not move is where it is at every s: checked as it is, ungrown (a
@@ -293,7 +304,7 @@ impl Checker {
         // A ball around the link, grown by the bound, apart from every box near it: clear at any
         // growth, without a walk of the cells.
         let (centre, radius) = self.motion_bounds().ball[ti];
-        if self.scene().ball_is_clear(pose * centre, radius + delta, |oi| !self.allowed[ti][oi]) {
+        if self.scene().ball_is_clear_near(pose * centre, radius + delta, |oi| !self.allowed[ti][oi], witness) {
             return Ok(Stretch::Clear);
         }
         let grown = grown_for(self.motion_bounds(), ti, pose, delta, path.floor(ti));

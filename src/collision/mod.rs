@@ -30,6 +30,7 @@ mod report;
 mod sat;
 mod scene;
 mod scene_ball;
+pub(crate) use self::scene_ball::BallWitness;
 mod scene_clearance;
 mod target;
 mod target_view;
