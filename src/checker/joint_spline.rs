@@ -21,6 +21,7 @@ use super::spline_poly::SegmentPoly;
 use super::state_report::StateReport;
 use crate::math::{pose_from_isometry, Pose, Real, Vector};
 use crate::model::JointKind;
+use std::cell::RefCell;
 
 /// One segment of an executed trajectory, in joint space.
 #[derive(Clone, Debug, PartialEq)]
@@ -58,22 +59,58 @@ pub(super) struct SplinePath<'a> {
     /// prismatic joint below it strays past its limits on this segment (the levers assume the
     /// limits; a spline can overshoot them).
     levers: Vec<Vec<(usize, Real)>>,
+    /// What the stretch last asked about holds for every target and pair asked there (the loop
+    /// examines a stretch's targets and pairs together).
+    stretch: RefCell<StretchBounds>,
+}
+
+/// Per joint, over one stretch: its excursion (see [`SplinePath::excursions`]), its rate at
+/// the middle, and the largest magnitude of its first and second derivatives; per target, its
+/// bound once found.
+#[derive(Default)]
+struct StretchBounds {
+    /// The bits of the stretch's middle and half-width (`None`: none yet).
+    key: Option<(u64, u64)>,
+    excursions: Vec<f64>,
+    rate: Vec<f64>,
+    top: Vec<f64>,
+    acceleration: Vec<f64>,
+    bound: Vec<Option<Real>>,
 }
 
 impl SplinePath<'_> {
+    /// The stretch of half-width `half` about `mid`'s [`StretchBounds`], found once.
+    fn stretch(&self, mid: f64, half: f64) -> std::cell::RefMut<'_, StretchBounds> {
+        let mut kept = self.stretch.borrow_mut();
+        let key = Some((mid.to_bits(), half.to_bits()));
+        if kept.key != key {
+            let k = &mut *kept;
+            k.key = key;
+            let (a, b) = ((mid - half).max(0.0), (mid + half).min(1.0));
+            k.excursions.clear();
+            k.excursions.extend(self.excursions(mid, half));
+            k.rate.clear();
+            k.top.clear();
+            k.acceleration.clear();
+            for [(d1, t1), (d2, t2)] in &self.rates {
+                k.rate.push(d1.at(mid));
+                k.top.push(d1.max_abs(t1, a, b));
+                k.acceleration.push(d2.max_abs(t2, a, b));
+            }
+            k.bound.clear();
+            k.bound.resize(self.speeds.len(), None);
+        }
+        kept
+    }
+
     /// Per joint: the excursion over `[mid - half, mid + half]` (within `[0, 1]`), grown by its
     /// tolerance, with a margin for the rounding of the polynomial's evaluation.
-    fn excursions(&self, mid: f64, half: f64) -> Vec<f64> {
+    fn excursions(&self, mid: f64, half: f64) -> impl Iterator<Item = f64> + '_ {
         let (a, b) = ((mid - half).max(0.0), (mid + half).min(1.0));
-        self.polys
-            .iter()
-            .zip(&self.turning)
-            .zip(&self.tolerance)
-            .map(|((p, t), tol)| {
-                let e = p.excursion(t, mid, a, b);
-                e + tol + 1e-12 * (1.0 + p.at(mid).abs())
-            })
-            .collect()
+        self.polys.iter().zip(&self.turning).zip(&self.tolerance).map(move |((p, t), tol)| {
+            let e = p.excursion(t, mid, a, b);
+            e + tol + 1e-12 * (1.0 + p.at(mid).abs())
+        })
     }
 
     /// Per joint that moves target `ti` and not target `other`, the sum of excursion times lever.
@@ -111,22 +148,19 @@ impl SplinePath<'_> {
         }
     }
 
-    /// The first-order bound of [`MotionPath::bound`], without the tolerance's share.
-    fn first_order(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
+    /// The first-order bound of [`MotionPath::bound`], without the tolerance's share, from the
+    /// stretch's rates.
+    fn first_order(&self, ti: usize, poses: &[Option<Pose>], half: f64, at: &StretchBounds) -> Real {
         let robot = self.checker.robot();
         let bounds = self.checker.motion_bounds();
         let Some(link) = poses[self.checker.targets()[ti].link] else { return Real::INFINITY };
         let (centre, radius) = bounds.ball[ti];
         let c = link * centre;
-        let (a, b) = ((mid - half).max(0.0), (mid + half).min(1.0));
         let (mut omega, mut velocity, mut rates) = (Vector::ZERO, Vector::ZERO, 0.0);
-        let mut top = vec![0.0; self.polys.len()];
         for &(j, r) in &self.levers[ti] {
             let joint = &robot.joints[j];
-            let [(d1, t1), (d2, t2)] = &self.rates[j];
-            let rate = d1.at(mid);
-            top[j] = d1.max_abs(t1, a, b);
-            rates += d2.max_abs(t2, a, b) * r;
+            let rate = at.rate[j];
+            rates += at.acceleration[j] * r;
             let Some(child) = poses[joint.child] else { return Real::INFINITY };
             let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
             match joint.kind {
@@ -138,9 +172,22 @@ impl SplinePath<'_> {
                 _ => {}
             }
         }
-        let speed: Real = self.levers[ti].iter().map(|(j, r)| top[*j] * r).sum();
-        let acceleration = rates + super::joint_motion::point_acceleration(robot, &self.levers[ti], &top, speed);
+        let speed: Real = self.levers[ti].iter().map(|(j, r)| at.top[*j] * r).sum();
+        let acceleration = rates + super::joint_motion::point_acceleration(robot, &self.levers[ti], &at.top, speed);
         half * (velocity.length() + omega.length() * radius) + 0.5 * half * half * acceleration
+    }
+
+    /// [`MotionPath::bound`] at the stretch `at`, found once per target.
+    fn bound_at(&self, ti: usize, poses: &[Option<Pose>], half: f64, at: &mut StretchBounds) -> Real {
+        if let Some(b) = at.bound[ti] {
+            return b;
+        }
+        let levers = self.bound_with(ti, poses, &at.excursions);
+        let first_order = self.first_order(ti, poses, half, at) + self.floors[ti];
+        // NaN (a bad pose) falls back to the lever bound.
+        let b = if first_order < levers { first_order } else { levers };
+        at.bound[ti] = Some(b);
+        b
     }
 }
 
@@ -163,14 +210,7 @@ impl MotionPath for SplinePath<'_> {
     /// over the stretch, from the polynomials). Plus the tolerance's share, which no stretch
     /// narrows.
     fn bound(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
-        let levers = self.bound_with(ti, poses, &self.excursions(mid, half));
-        let first_order = self.first_order(ti, poses, mid, half) + self.floors[ti];
-        // NaN (a bad pose) falls back to the lever bound.
-        if first_order < levers {
-            first_order
-        } else {
-            levers
-        }
+        self.bound_at(ti, poses, half, &mut self.stretch(mid, half))
     }
 
     fn out_of_limits(&self, s: f64) -> Vec<String> {
@@ -189,17 +229,27 @@ impl MotionPath for SplinePath<'_> {
     /// above both links move the pair as one body); with one, the world bounds, whose floor
     /// [`MotionPath::floor`] gives.
     fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> (Real, Real) {
-        let e = self.excursions(mid, half);
-        let world = (self.bound_with(a, poses, &e), self.bound_with(b, poses, &e));
+        let mut at = self.stretch(mid, half);
+        let world = (self.bound_at(a, poses, half, &mut at), self.bound_at(b, poses, half, &mut at));
         if self.floors[a] > 0.0 || self.floors[b] > 0.0 {
             return world;
         }
-        let relative = (self.own(a, b, &e), self.own(b, a, &e));
+        let relative = (self.own(a, b, &at.excursions), self.own(b, a, &at.excursions));
         if relative.0 + relative.1 <= world.0 + world.1 {
             relative
         } else {
             world
         }
+    }
+
+    /// Without a tolerance, the relative lever sums of [`SplinePath::pair_bound`] alone (no
+    /// pose is read); with one, its world bounds.
+    fn pair_bound_quick(&self, a: usize, b: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> (Real, Real) {
+        if self.floors[a] > 0.0 || self.floors[b] > 0.0 {
+            return self.pair_bound(a, b, poses, mid, half);
+        }
+        let at = self.stretch(mid, half);
+        (self.own(a, b, &at.excursions), self.own(b, a, &at.excursions))
     }
 }
 
@@ -276,7 +326,7 @@ impl Checker {
             .collect();
         let speeds = levers.iter().map(|l| l.iter().map(|(j, r)| (top[*j] + tolerance[*j]) * r).sum()).collect();
         let floors = levers.iter().map(|l| l.iter().map(|(j, r)| tolerance[*j] * r).sum()).collect();
-        Ok(SplinePath { checker: self, segment, polys, turning, tolerance, rates, speeds, floors, levers })
+        Ok(SplinePath { checker: self, segment, polys, turning, tolerance, rates, speeds, floors, levers, stretch: RefCell::default() })
     }
 }
 
