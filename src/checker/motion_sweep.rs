@@ -143,6 +143,25 @@ struct Pending {
     members: std::ops::Range<usize>,
 }
 
+/// One stretch as its targets and pairs are judged: the link poses at its middle, its start and
+/// its half-width.
+#[derive(Clone, Copy)]
+struct At<'p> {
+    poses: &'p [Option<Pose>],
+    start: f64,
+    half: f64,
+}
+
+/// What one motion's loop learns as it goes, besides its stretches: per target or pair whether
+/// it was tried at the start (and the start's link poses), per pair the axis that last
+/// separated it, per target the cell box that stopped its last ball walk.
+struct Learned {
+    probed: Vec<bool>,
+    start_poses: Option<Vec<Option<Pose>>>,
+    hints: Vec<Vector>,
+    witnesses: Vec<Option<BallWitness>>,
+}
+
 impl Checker {
     /// The adaptive loop over `path` (see the module documentation of `joint_motion`): every
     /// target against the environment and every self pair, examined together by bisection, left
@@ -151,73 +170,15 @@ impl Checker {
     /// all, and nothing past it is examined (a motion that collides early costs what its start
     /// costs).
     pub(super) fn sweep_motion(&self, path: &impl MotionPath) -> MotionReport {
-        let targets = self.targets().len();
-        let pairs = &self.self_pairs().pairs;
-        // One list for every pending stretch: a stretch's survivors are appended after its own
-        // members, and both halves share them. The stack is last in, first out, so when a stretch
-        // is taken, whatever follows its members belongs to stretches already done.
-        let mut members: Vec<u32> = (0..(targets + pairs.len()) as u32).collect();
-        let mut stack = Vec::with_capacity(64);
-        stack.push(Pending { a: 0.0, b: 1.0, members: 0..members.len() });
         let mut examined = 0u64;
-        let mut blocked: Option<Blocked> = None;
-        let mut probed = vec![false; members.len()];
-        let mut hints = vec![Vector::ZERO; pairs.len()];
-        let mut witnesses = vec![None; targets];
-        let mut start_poses = None;
-        let run = (|| -> Result<(), String> {
-            while let Some(Pending { a, b, members: mine }) = stack.pop() {
-                members.truncate(mine.end);
-                let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
-                let poses = path.link_poses(mid)?;
-                let survivors = members.len();
-                for k in mine {
-                    examined += 1;
-                    if examined > MAX_SUBINTERVALS {
-                        return Err(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"));
-                    }
-                    let i = members[k] as usize;
-                    let verdict = match pairs.get(i.wrapping_sub(targets)) {
-                        Some(&(ta, tb)) if i >= targets => self.judge_pair(path, ta, tb, &poses, a, half, &mut hints[i - targets])?,
-                        _ => self.judge_target(path, i, &poses, a, half, &mut witnesses[i])?,
-                    };
-                    match verdict {
-                        Stretch::Clear => {}
-                        Stretch::Split { met } => {
-                            // Perhaps meeting something at the motion's start: if it does, the
-                            // motion is blocked at 0 (the earliest there is) without descending
-                            // to the tolerance. Asked once per target or pair: a target as soon
-                            // as it is not cleared (its ball at the start first), a pair once
-                            // its grown test has met something (a pair's test is cheap, but
-                            // near pairs are many).
-                            if a == 0.0 && !probed[i] && (met || i < targets) {
-                                probed[i] = true;
-                                if let Some(found) = self.blocked_at_start(path, i, &mut start_poses)? {
-                                    blocked = Some(found);
-                                    return Ok(());
-                                }
-                            }
-                            members.push(i as u32);
-                        }
-                        Stretch::Blocked(found) => {
-                            blocked = Some(found);
-                            return Ok(());
-                        }
-                    }
-                }
-                if members.len() > survivors {
-                    let split = survivors..members.len();
-                    stack.push(Pending { a: mid, b, members: split.clone() });
-                    stack.push(Pending { a, b: mid, members: split });
-                }
+        let blocked = match self.first_blocked(path, &mut examined) {
+            Ok(blocked) => blocked,
+            Err(error) => {
+                let mut report = StateReport::failed(error);
+                report.motion = true;
+                return MotionReport { report, fraction: None, subintervals: examined };
             }
-            Ok(())
-        })();
-        if let Err(error) = run {
-            let mut report = StateReport::failed(error);
-            report.motion = true;
-            return MotionReport { report, fraction: None, subintervals: examined };
-        }
+        };
         match blocked {
             None => {
                 // A free motion stands for its end pose: the clearances are that pose's.
@@ -233,6 +194,72 @@ impl Checker {
                 blocked_report(report, b.fraction, examined)
             }
         }
+    }
+
+    /// The bisection of [`Checker::sweep_motion`]: the first stretch blocked, or `None` when
+    /// every target and pair is cleared over the whole motion; `examined` counts (target or
+    /// pair, stretch) pairs.
+    fn first_blocked(&self, path: &impl MotionPath, examined: &mut u64) -> Result<Option<Blocked>, String> {
+        let count = self.targets().len() + self.self_pairs().pairs.len();
+        // One list for every pending stretch: a stretch's survivors are appended after its own
+        // members, and both halves share them. The stack is last in, first out, so when a stretch
+        // is taken, whatever follows its members belongs to stretches already done.
+        let mut members: Vec<u32> = (0..count as u32).collect();
+        let mut stack = Vec::with_capacity(64);
+        stack.push(Pending { a: 0.0, b: 1.0, members: 0..members.len() });
+        let mut learned = Learned {
+            probed: vec![false; count],
+            start_poses: None,
+            hints: vec![Vector::ZERO; self.self_pairs().pairs.len()],
+            witnesses: vec![None; self.targets().len()],
+        };
+        while let Some(Pending { a, b, members: mine }) = stack.pop() {
+            members.truncate(mine.end);
+            let mid = 0.5 * (a + b);
+            let poses = path.link_poses(mid)?;
+            let at = At { poses: &poses, start: a, half: 0.5 * (b - a) };
+            let survivors = members.len();
+            for k in mine {
+                *examined += 1;
+                if *examined > MAX_SUBINTERVALS {
+                    return Err(format!("the motion needs more than {MAX_SUBINTERVALS} sub-intervals to clear; not checked"));
+                }
+                let i = members[k] as usize;
+                match self.judge_member(path, i, at, &mut learned)? {
+                    Stretch::Clear => {}
+                    Stretch::Split { .. } => members.push(i as u32),
+                    Stretch::Blocked(found) => return Ok(Some(found)),
+                }
+            }
+            if members.len() > survivors {
+                let split = survivors..members.len();
+                stack.push(Pending { a: mid, b, members: split.clone() });
+                stack.push(Pending { a, b: mid, members: split });
+            }
+        }
+        Ok(None)
+    }
+
+    /// Member `i` of the loop (a target, then the self pairs) on the stretch `at`. Perhaps
+    /// meeting something at the motion's start: if it does, the motion is blocked at 0 (the
+    /// earliest there is) without descending to the tolerance. Asked once per target or pair: a
+    /// target as soon as it is not cleared (its ball at the start first), a pair once its grown
+    /// test has met something (a pair's test is cheap, but near pairs are many).
+    fn judge_member(&self, path: &impl MotionPath, i: usize, at: At, learned: &mut Learned) -> Result<Stretch, String> {
+        let targets = self.targets().len();
+        let verdict = match self.self_pairs().pairs.get(i.wrapping_sub(targets)) {
+            Some(&(ta, tb)) if i >= targets => self.judge_pair(path, ta, tb, at, &mut learned.hints[i - targets])?,
+            _ => self.judge_target(path, i, at, &mut learned.witnesses[i])?,
+        };
+        if let Stretch::Split { met } = verdict {
+            if at.start == 0.0 && !learned.probed[i] && (met || i < targets) {
+                learned.probed[i] = true;
+                if let Some(found) = self.blocked_at_start(path, i, &mut learned.start_poses)? {
+                    return Ok(Stretch::Blocked(found));
+                }
+            }
+        }
+        Ok(verdict)
     }
 
     /// Whether member `i` of the sweep (a target, then the self pairs) meets something, as it
@@ -287,15 +314,8 @@ impl Checker {
     /// A stretch of target `ti` against the environment.
     /// `witness`: a cell's box found within the target's ball at an earlier stretch (see
     /// [`crate::collision::BallWitness`]): a target near a surface is mostly still near it.
-    fn judge_target(
-        &self,
-        path: &impl MotionPath,
-        ti: usize,
-        poses: &[Option<Pose>],
-        start: f64,
-        half: f64,
-        witness: &mut Option<BallWitness>,
-    ) -> Result<Stretch, String> {
+    fn judge_target(&self, path: &impl MotionPath, ti: usize, at: At, witness: &mut Option<BallWitness>) -> Result<Stretch, String> {
+        let At { poses, start, half } = at;
         let lt = &self.targets()[ti];
         let pose = poses[lt.link].ok_or_else(|| format!("no pose for link '{}'", lt.name))?;
         // A link that does not move is where it is at every s: checked as it is, ungrown (a
@@ -316,16 +336,8 @@ impl Checker {
     /// its own displacement bound, do not meet (then they stay apart all along the stretch).
     /// `hint`: the axis that last separated the pair, in the first link's frame (see
     /// [`crate::collision::pair_may_meet_grown`]).
-    fn judge_pair(
-        &self,
-        path: &impl MotionPath,
-        ta: usize,
-        tb: usize,
-        poses: &[Option<Pose>],
-        start: f64,
-        half: f64,
-        hint: &mut Vector,
-    ) -> Result<Stretch, String> {
+    fn judge_pair(&self, path: &impl MotionPath, ta: usize, tb: usize, at: At, hint: &mut Vector) -> Result<Stretch, String> {
+        let At { poses, start, half } = at;
         let (la, lb) = (&self.targets()[ta], &self.targets()[tb]);
         let (Some(pa), Some(pb)) = (poses[la.link], poses[lb.link]) else {
             return Err(format!("no pose for link '{}' or '{}'", la.name, lb.name));
