@@ -336,6 +336,84 @@ mod tests {
     use crate::checker::test_points::part_points;
     use crate::model::Params;
 
+    /// A random segment of `robot`: quintic, cubic or linear by `case`, every fifth out and
+    /// back (its extreme inside), every other with a random path tolerance per joint.
+    fn random_segment(robot: &crate::model::RobotModel, case: usize, draw: &mut impl FnMut(f64, f64) -> f64) -> SplineSegment {
+        let duration = draw(0.2, 2.0);
+        let joints: Vec<SegmentPoly> = robot
+            .joints
+            .iter()
+            .map(|j| {
+                let [lo, hi] = j.limits;
+                let (lo, hi) = if lo.is_finite() && hi.is_finite() { (lo, hi) } else { (-3.0, 3.0) };
+                let (p0, mut p1) = (draw(lo, hi), draw(lo, hi));
+                let (mut v0, mut v1, a0, a1) = (draw(-2.0, 2.0), draw(-2.0, 2.0), draw(-8.0, 8.0), draw(-8.0, 8.0));
+                if case % 5 == 0 {
+                    (p1, v0, v1) = (p0, 2.0 * duration, -2.0 * duration);
+                }
+                match case % 3 {
+                    0 => SegmentPoly::quintic(p0, v0, a0, p1, v1, a1, duration),
+                    1 => SegmentPoly::cubic(p0, v0, p1, v1, duration),
+                    _ => SegmentPoly::linear(p0, p1),
+                }
+            })
+            .collect();
+        let tolerance = if case % 2 == 0 { Vec::new() } else { robot.joints.iter().map(|_| draw(0.0, 0.05)).collect() };
+        SplineSegment { joints, tolerance }
+    }
+
+    /// The self pairs' bounds on a spline, checked directly: within a stretch, no distance
+    /// between a point of one link of a pair and a point of the other changes by more than the
+    /// sum of the pair's bounds, the quick ones (the relative lever sums) or the full ones, over
+    /// random segments of the bundled arm, with and without a tolerance (then at configurations
+    /// of the tube too).
+    #[test]
+    fn no_distance_within_a_self_pair_leaves_its_bounds_on_a_spline() {
+        let c = Checker::from_params(Params::default()).unwrap();
+        let robot = c.robot();
+        let mut rng = oorandom::Rand64::new(45);
+        let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
+        let points: Vec<Vec<Vector>> = c.targets().iter().map(|t| t.parts.iter().flat_map(|(shape, offset)| part_points(shape, offset)).collect()).collect();
+        let (mut checked, mut tightest) = (0usize, 0.0f64);
+        for case in 0..120 {
+            let segment = random_segment(robot, case, &mut draw);
+            let path = c.spline_path(&segment).unwrap();
+            let half = [0.5, 0.2, 0.05, 0.01][case % 4];
+            let s = draw(0.0, 1.0);
+            let poses = path.link_poses(s).unwrap();
+            let others: Vec<Vec<Option<Pose>>> = (0..=8)
+                .map(|k| {
+                    let mut q = segment.at((s - half + 2.0 * half * k as f64 / 8.0).clamp(0.0, 1.0));
+                    q.iter_mut().zip(&segment.tolerance).for_each(|(x, t)| *x += t * [-1.0, 1.0, 0.3][k % 3]);
+                    robot.forward_kinematics(&q, c.base_pose()).unwrap().iter().map(|p| Some(pose_from_isometry(p))).collect()
+                })
+                .collect();
+            for &(a, b) in &c.self_pairs().pairs {
+                let (qa, qb) = path.pair_bound_quick(a, b, &poses, s, half);
+                let (da, db) = path.pair_bound(a, b, &poses, s, half);
+                let (la, lb) = (c.targets()[a].link, c.targets()[b].link);
+                let mut largest = 0.0f64;
+                for other in &others {
+                    for p in points[a].iter().step_by(3) {
+                        for q in points[b].iter().step_by(3) {
+                            let at = (poses[la].unwrap() * *p - poses[lb].unwrap() * *q).length();
+                            let then = (other[la].unwrap() * *p - other[lb].unwrap() * *q).length();
+                            largest = largest.max((then - at).abs());
+                        }
+                    }
+                }
+                assert!(largest <= qa + qb + 1e-9, "case {case}, pair ({a}, {b}): a distance changed by {largest}, quick bounds {qa} + {qb}");
+                assert!(largest <= da + db + 1e-9, "case {case}, pair ({a}, {b}): a distance changed by {largest}, bounds {da} + {db}");
+                if da + db > 0.0 {
+                    tightest = tightest.max(largest / (da + db));
+                }
+                checked += 1;
+            }
+        }
+        assert!(checked > 200 && tightest > 0.3, "{checked} pair stretches, largest change / bound {tightest}");
+        eprintln!("{checked} pair stretches, largest change / bound {tightest:.3}");
+    }
+
     /// The bound the adaptive loop trusts, checked directly: over random quintic, cubic and linear
     /// segments of the bundled arm (revolute, continuous, prismatic and mimic joints), with and
     /// without a tolerance, no point of any link, sampled along a stretch (and, with a tolerance,
@@ -349,28 +427,8 @@ mod tests {
         let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
         let (mut checked, mut tightest) = (0usize, 0.0f64);
         for case in 0..300 {
-            let duration = draw(0.2, 2.0);
-            let joints: Vec<SegmentPoly> = robot
-                .joints
-                .iter()
-                .map(|j| {
-                    let [lo, hi] = j.limits;
-                    let (lo, hi) = if lo.is_finite() && hi.is_finite() { (lo, hi) } else { (-3.0, 3.0) };
-                    let (p0, mut p1) = (draw(lo, hi), draw(lo, hi));
-                    let (mut v0, mut v1, a0, a1) = (draw(-2.0, 2.0), draw(-2.0, 2.0), draw(-8.0, 8.0), draw(-8.0, 8.0));
-                    if case % 5 == 0 {
-                        // Out and back: the extreme is inside the segment, away from its ends.
-                        (p1, v0, v1) = (p0, 2.0 * duration, -2.0 * duration);
-                    }
-                    match case % 3 {
-                        0 => SegmentPoly::quintic(p0, v0, a0, p1, v1, a1, duration),
-                        1 => SegmentPoly::cubic(p0, v0, p1, v1, duration),
-                        _ => SegmentPoly::linear(p0, p1),
-                    }
-                })
-                .collect();
-            let tolerance = if case % 2 == 0 { Vec::new() } else { robot.joints.iter().map(|_| draw(0.0, 0.05)).collect() };
-            let segment = SplineSegment { joints, tolerance: tolerance.clone() };
+            let segment = random_segment(robot, case, &mut draw);
+            let tolerance = segment.tolerance.clone();
             let path = c.spline_path(&segment).unwrap();
             let half = [0.5, 0.2, 0.05, 0.01][checked % 4];
             let s = draw(0.0, 1.0);
