@@ -5,7 +5,7 @@ use super::checker::Checker;
 use super::motion_bounds::grow;
 use super::motion_sweep::Grown;
 use super::state_report::{ObjectType, ReportContact, StateReport};
-use crate::collision::{collide_pair, pair_may_meet_grown, CollideSettings, KeptLeaves, PairContact, Target, TargetShape};
+use crate::collision::{collide_pair, pair_may_meet_grown, CollideSettings, PairContact, Target, TargetShape};
 use crate::math::{Pose, Real, Vector};
 
 impl Checker {
@@ -26,18 +26,6 @@ impl Checker {
         self.targets()[g.ti].parts.iter().enumerate().any(|(pi, (_, offset))| {
             let target = Target::new(self.grown_part(g.ti, pi, g.level).clone(), g.pose * *offset);
             !self.collide_target(g.ti, &target, settings).contacts.is_empty()
-        })
-    }
-
-    /// [`Checker::grown_link_hit`] flags only, through the leaves `kept` for the target near
-    /// where it was tested before (see [`crate::collision::KeptLeaves`]): the regions made
-    /// anew reach the growth around the grown part's box, so a half of the stretch fits in its
-    /// stretch's region.
-    pub(super) fn grown_link_hit_kept(&self, g: &Grown, kept: &mut Vec<KeptLeaves>) -> bool {
-        let margin = g.level.map_or(0.0, |level| self.motion_bounds().growth(level));
-        self.targets()[g.ti].parts.iter().enumerate().any(|(pi, (_, offset))| {
-            let target = Target::new(self.grown_part(g.ti, pi, g.level).clone(), g.pose * *offset);
-            self.scene().any_hit_kept(&target, &|oi| !self.allowed[g.ti][oi], pi, margin, kept)
         })
     }
 

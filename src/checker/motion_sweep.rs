@@ -7,7 +7,7 @@
 use super::checker::Checker;
 use super::motion_bounds::MotionBounds;
 use super::state_report::StateReport;
-use crate::collision::{BallWitness, CollideSettings, KeptLeaves};
+use crate::collision::{BallWitness, CollideSettings};
 use crate::math::{Pose, Real, Vector};
 
 /// Sub-intervals examined at most per motion; past that the motion fails closed.
@@ -160,7 +160,6 @@ struct Learned {
     start_poses: Option<Vec<Option<Pose>>>,
     hints: Vec<Vector>,
     witnesses: Vec<Option<BallWitness>>,
-    kept: Vec<Vec<KeptLeaves>>,
 }
 
 impl Checker {
@@ -213,7 +212,6 @@ impl Checker {
             start_poses: None,
             hints: vec![Vector::ZERO; self.self_pairs().pairs.len()],
             witnesses: vec![None; self.targets().len()],
-            kept: vec![Vec::new(); self.targets().len()],
         };
         while let Some(Pending { a, b, members: mine }) = stack.pop() {
             members.truncate(mine.end);
@@ -251,7 +249,7 @@ impl Checker {
         let targets = self.targets().len();
         let verdict = match self.self_pairs().pairs.get(i.wrapping_sub(targets)) {
             Some(&(ta, tb)) if i >= targets => self.judge_pair(path, ta, tb, at, &mut learned.hints[i - targets])?,
-            _ => self.judge_target(path, i, at, &mut learned.witnesses[i], &mut learned.kept[i])?,
+            _ => self.judge_target(path, i, at, &mut learned.witnesses[i])?,
         };
         if let Stretch::Split { met } = verdict {
             if at.start == 0.0 && !learned.probed[i] && (met || i < targets) {
@@ -316,14 +314,7 @@ impl Checker {
     /// A stretch of target `ti` against the environment.
     /// `witness`: a cell's box found within the target's ball at an earlier stretch (see
     /// [`crate::collision::BallWitness`]): a target near a surface is mostly still near it.
-    fn judge_target(
-        &self,
-        path: &impl MotionPath,
-        ti: usize,
-        at: At,
-        witness: &mut Option<BallWitness>,
-        kept: &mut Vec<KeptLeaves>,
-    ) -> Result<Stretch, String> {
+    fn judge_target(&self, path: &impl MotionPath, ti: usize, at: At, witness: &mut Option<BallWitness>) -> Result<Stretch, String> {
         let At { poses, start, half } = at;
         let lt = &self.targets()[ti];
         let pose = poses[lt.link].ok_or_else(|| format!("no pose for link '{}'", lt.name))?;
@@ -337,7 +328,8 @@ impl Checker {
             return Ok(Stretch::Clear);
         }
         let grown = grown_for(self.motion_bounds(), ti, pose, delta, path.floor(ti));
-        Ok(Stretch::judge(start, grown, None, || self.grown_link_hit_kept(&grown, kept)))
+        let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
+        Ok(Stretch::judge(start, grown, None, || self.grown_link_hit(&grown, &flags)))
     }
 
     /// A stretch of self pair `(ta, tb)`: cleared when its two links at the middle, each grown by

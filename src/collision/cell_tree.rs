@@ -251,39 +251,6 @@ impl CellTree {
         let _ = node;
     }
 
-    /// The leaves whose boxes meet `region` (the tree's frame) into `out`, at most `limit` of
-    /// them: `false` (and `out` incomplete) past that. Every cell whose box meets `region` is in
-    /// one of them (a node's box holds its children's).
-    pub(crate) fn leaves_meeting(&self, region: &Aabb, limit: usize, out: &mut Vec<u32>) -> bool {
-        out.clear();
-        if self.is_empty() {
-            return true;
-        }
-        let mut stack = vec![0u32];
-        while let Some(node) = stack.pop() {
-            let n = &self.nodes[node as usize];
-            if n.lo.x > region.maxs.x
-                || n.lo.y > region.maxs.y
-                || n.lo.z > region.maxs.z
-                || n.hi.x < region.mins.x
-                || n.hi.y < region.mins.y
-                || n.hi.z < region.mins.z
-            {
-                continue;
-            }
-            match self.children(node) {
-                Some(children) => stack.extend(children),
-                None => {
-                    if out.len() == limit {
-                        return false;
-                    }
-                    out.push(node);
-                }
-            }
-        }
-        true
-    }
-
     /// The children of an inner node; `None` for a leaf.
     #[inline]
     pub(crate) fn children(&self, node: u32) -> Option<[u32; 2]> {

@@ -21,7 +21,6 @@ mod cell_slab;
 mod cell_tree;
 mod cell_walk;
 mod collector;
-pub(crate) use self::collector::KeptLeaves;
 mod contact_point;
 mod convex_hull;
 mod gjk;

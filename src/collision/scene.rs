@@ -1,11 +1,11 @@
 //! The environment: objects with their cells in a BVH, and the queries against them.
 
 use super::cell_tree::CellTree;
-use super::collector::{AllHits, AnyHit, AnyHitKept, Collector, DeepestHit, KeptLeaves};
+use super::collector::{AllHits, AnyHit, Collector, DeepestHit};
 use super::report::{CollideSettings, TargetReport};
 use super::target::{Target, TargetShape};
 use super::target_view::{transformed_box, TargetView};
-use crate::math::{Aabb, Pose, Real};
+use crate::math::{Aabb, Pose};
 use crate::thickness::ThicknessArea;
 use parry3d_f64::bounding_volume::BoundingVolume;
 use std::sync::Arc;
@@ -188,14 +188,6 @@ impl Scene {
             return self.query(target, &check, AllHits::default()).report;
         }
         self.query(target, &check, DeepestHit::new(settings.least_overlap)).into_report()
-    }
-
-    /// Whether part `part` of a target meets any object `check` selects (a flags-only
-    /// [`Scene::collide_filtered`]), through the leaves `kept` for that part near where it was
-    /// asked before: see [`AnyHitKept`]; `margin` is how far around the target's box a region
-    /// made anew reaches.
-    pub(crate) fn any_hit_kept(&self, target: &Target, check: &impl Fn(usize) -> bool, part: usize, margin: Real, kept: &mut Vec<KeptLeaves>) -> bool {
-        !self.query(target, check, AnyHitKept::new(part, margin, kept)).report.contacts.is_empty()
     }
 
     /// The one walk of every query: the objects for which `check(object index)` is true, whose
