@@ -460,6 +460,22 @@ mod tests {
         assert!(back.fraction.unwrap() > 0.0 && back.subintervals > members, "{back:?}");
     }
 
+    /// A short motion away from everything is cleared on one stretch, every target and pair
+    /// examined once; a long one starts from several (its links' bounds over the whole motion
+    /// are far past what could be cleared), each examined on each.
+    #[test]
+    fn a_short_motion_is_examined_whole_and_a_long_one_in_pieces() {
+        let c = arm();
+        let members = (c.targets().len() + c.self_pairs().pairs.len()) as u64;
+        let free = q(&c, &[]);
+        let near = q(&c, &[("shoulder_pan_joint", 1e-3), ("elbow_joint", -1e-3)]);
+        let r = c.check_motion(&free, &near);
+        assert!(!r.report.in_collision && r.subintervals == members, "{r:?}");
+        let far = q(&c, &[("shoulder_pan_joint", 3.0), ("wrist_1_joint", 2.0)]);
+        let r = c.check_motion(&free, &far);
+        assert!(r.subintervals >= 2 * members, "{} stretches examined, {members} targets and pairs", r.subintervals);
+    }
+
     #[test]
     fn a_crossing_between_free_states_is_found_and_a_free_motion_is_free() {
         let c = arm();
