@@ -318,7 +318,7 @@ impl Checker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::checker::test_points::part_points;
+    use crate::checker::test_points::{largest_pair_change, part_points};
     use crate::model::Params;
 
     fn arm() -> Checker {
@@ -383,16 +383,7 @@ mod tests {
             for &(a, b) in &c.self_pairs().pairs {
                 let (da, db) = path.pair_bound(a, b, &poses, s, half);
                 let (la, lb) = (c.targets()[a].link, c.targets()[b].link);
-                let mut largest = 0.0f64;
-                for other in &others {
-                    for p in points[a].iter().step_by(3) {
-                        for q in points[b].iter().step_by(3) {
-                            let at = (poses[la].unwrap() * *p - poses[lb].unwrap() * *q).length();
-                            let then = (other[la].unwrap() * *p - other[lb].unwrap() * *q).length();
-                            largest = largest.max((then - at).abs());
-                        }
-                    }
-                }
+                let largest = largest_pair_change(&points[a], la, &points[b], lb, &poses, &others);
                 assert!(largest <= da + db + 1e-9, "pair ({a}, {b}): a distance changed by {largest} within {half} of s = {s}, bounds {da} + {db}");
                 if da + db > 0.0 {
                     tightest = tightest.max(largest / (da + db));

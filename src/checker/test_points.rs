@@ -15,3 +15,20 @@ pub(crate) fn part_points(shape: &TargetShape, offset: &Pose) -> Vec<Vector> {
     };
     local.into_iter().map(|p| *offset * p).collect()
 }
+
+/// The largest change, from the poses `at` to any of `others`, of the distance between a point
+/// of `points_a` on link `la` and one of `points_b` on link `lb` (every third point of each).
+pub(crate) fn largest_pair_change(points_a: &[Vector], la: usize, points_b: &[Vector], lb: usize, at: &[Option<Pose>], others: &[Vec<Option<Pose>>]) -> Real {
+    let posed = |poses: &[Option<Pose>], link: usize| poses[link].expect("every link posed");
+    let mut largest: Real = 0.0;
+    for other in others {
+        for p in points_a.iter().step_by(3) {
+            for q in points_b.iter().step_by(3) {
+                let now = (posed(at, la) * *p - posed(at, lb) * *q).length();
+                let then = (posed(other, la) * *p - posed(other, lb) * *q).length();
+                largest = largest.max((then - now).abs());
+            }
+        }
+    }
+    largest
+}
