@@ -108,7 +108,7 @@ impl MotionBounds {
             // origin of the joint reached so far, in any configuration.
             let mut chain = 0.0;
             let mut list = Vec::new();
-            let mut speeds = Vec::new();
+            let mut own_steady = Vec::new();
             // The target's link frame in the frame of `link`, while only fixed joints lie between.
             let mut rigid = Some(Pose::IDENTITY);
             let mut link = t.link;
@@ -121,11 +121,11 @@ impl MotionBounds {
                         // The axis is fixed in the joint's child frame, which is `link`'s.
                         let axis = Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
                         let on_axis = rigid.map_or(Real::INFINITY, |r| t.parts.iter().map(|(s, o)| part_axis_reach(s, &(r * *o), axis)).fold(0.0, Real::max));
-                        speeds.push((chain + reach).min(on_axis));
+                        own_steady.push((chain + reach).min(on_axis));
                     }
                     JointKind::Prismatic => {
                         list.push((j, 1.0));
-                        speeds.push(1.0);
+                        own_steady.push(1.0);
                     }
                     JointKind::Fixed | JointKind::Floating | JointKind::Planar => {}
                 }
@@ -144,7 +144,7 @@ impl MotionBounds {
                 }
             }
             levers.push(list);
-            steady.push(speeds);
+            steady.push(own_steady);
         }
         let grown = targets.iter().map(|t| t.parts.iter().map(|_| (0..LEVELS).map(|_| OnceLock::new()).collect()).collect()).collect();
         let ball = targets.iter().map(|t| target_ball(&t.parts)).collect();

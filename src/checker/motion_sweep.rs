@@ -22,13 +22,19 @@ pub(crate) const MAX_SUBINTERVALS: u64 = 1 << 20;
 /// motion on the peer world and 7.19, 6.57, 6.41, 6.40, 6.47, 7.22 on the wall (10,000 motions).
 const MAX_TESTED_GROWTH: Real = 0.06;
 
-/// The growth the fastest link's bound is brought to, about, by the stretches a motion is first
-/// split into (metres), at most `MAX_FIRST_PIECES` of them. On the motion benchmark (planner-like
-/// edges, 5,000 wall motions, three runs each), starting from the whole motion, halves, quarters
-/// and eighths gave 3.65, 3.43, 3.36 and 3.62 state checks per motion; the fastest links' bounds
-/// on its quarters are about 0.3 m.
+/// The growth the fastest link's steady lever bound (its speed times the half-width) is brought
+/// to, about, by the equal stretches a motion is first split into (metres). On the motion
+/// benchmark (planner-like edges, 5,000 wall motions, three runs each), starting every motion from
+/// the whole, halves, quarters and eighths gave 3.65, 3.43, 3.36 and 3.62 state checks per motion;
+/// this bound gives mostly quarters there (3.35), 0.3 m mostly eighths (3.46), and a short motion
+/// one stretch.
 const FIRST_GROWTH: Real = 0.6;
+/// Stretches a motion is first split into at most.
 const MAX_FIRST_PIECES: u32 = 8;
+
+/// A flags-only question of the cells: the motion loop asks only whether a grown link meets
+/// anything.
+const FLAGS: CollideSettings = CollideSettings { all_contacts: false, flag_only: true, least_overlap: false };
 
 /// What a motion check gives.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -266,9 +272,9 @@ impl Checker {
     /// test has met something (a pair's test is cheap, but near pairs are many).
     fn judge_member(&self, path: &impl MotionPath, i: usize, at: At, learned: &mut Learned) -> Result<Stretch, String> {
         let targets = self.targets().len();
-        let verdict = match self.self_pairs().pairs.get(i.wrapping_sub(targets)) {
-            Some(&(ta, tb)) if i >= targets => self.judge_pair(path, ta, tb, at, &mut learned.hints[i - targets])?,
-            _ => self.judge_target(path, i, at, &mut learned.witnesses[i])?,
+        let verdict = match self.member_pair(i) {
+            Some((ta, tb)) => self.judge_pair(path, ta, tb, at, &mut learned.hints[i - targets])?,
+            None => self.judge_target(path, i, at, &mut learned.witnesses[i])?,
         };
         if let Stretch::Split { met } = verdict {
             if at.start == 0.0 && !learned.probed[i] && (met || i < targets) {
@@ -281,6 +287,12 @@ impl Checker {
         Ok(verdict)
     }
 
+    /// Member `i` of the loop as a self pair (the targets come first, then the pairs); `None`
+    /// for a target.
+    fn member_pair(&self, i: usize) -> Option<(usize, usize)> {
+        i.checked_sub(self.targets().len()).and_then(|p| self.self_pairs().pairs.get(p)).copied()
+    }
+
     /// Whether member `i` of the sweep (a target, then the self pairs) meets something, as it
     /// is, at the motion's start: then the motion is blocked there. `poses` keeps the start's
     /// link poses for the next member asked.
@@ -289,24 +301,22 @@ impl Checker {
             Some(p) => p,
             None => poses.insert(path.link_poses(0.0)?),
         };
-        let targets = self.targets().len();
         let at = |ti: usize| -> Result<Grown, String> {
             let lt = &self.targets()[ti];
             let pose = poses[lt.link].ok_or_else(|| format!("no pose for link '{}'", lt.name))?;
             Ok(Grown { ti, level: None, tested: true, settled: true, pose })
         };
-        let found = match self.self_pairs().pairs.get(i.wrapping_sub(targets)) {
-            Some(&(ta, tb)) if i >= targets => {
+        let found = match self.member_pair(i) {
+            Some((ta, tb)) => {
                 let (a, b) = (at(ta)?, at(tb)?);
                 let mut hint = Vector::ZERO;
                 self.pair_may_meet_within(&a, 0.0, &b, 0.0, &mut hint).then_some(Blocked { fraction: 0.0, grown: a, other: Some(b) })
             }
-            _ => {
+            None => {
                 let g = at(i)?;
                 let (centre, radius) = self.motion_bounds().ball[i];
-                let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
                 let near = !self.scene().ball_is_clear(g.pose * centre, radius, |oi| !self.allowed[i][oi]);
-                (near && self.grown_link_hit(&g, &flags)).then_some(Blocked { fraction: 0.0, grown: g, other: None })
+                (near && self.grown_link_hit(&g, &FLAGS)).then_some(Blocked { fraction: 0.0, grown: g, other: None })
             }
         };
         Ok(found)
@@ -314,8 +324,8 @@ impl Checker {
 
     /// The report of the state where the motion is blocked: only the blocked target or pair is
     /// checked there (every other was cleared over stretches covering that state), unless the
-    /// motion is blocked at its start (the targets and pairs after the blocked one were then not
-    /// examined at all) or clearances are asked for (they need every link).
+    /// motion is blocked at its start (the targets and pairs after the one found there were not
+    /// examined) or clearances are asked for (they need every link).
     fn report_where_blocked(&self, path: &impl MotionPath, b: &Blocked) -> StateReport {
         if self.params().clearance_threshold > 0.0 || b.fraction <= 0.0 {
             return path.report_at(b.fraction);
@@ -347,8 +357,7 @@ impl Checker {
             return Ok(Stretch::Clear);
         }
         let grown = grown_for(self.motion_bounds(), ti, pose, delta, path.floor(ti));
-        let flags = CollideSettings { flag_only: true, least_overlap: false, ..Default::default() };
-        Ok(Stretch::judge(start, grown, None, || self.grown_link_hit(&grown, &flags)))
+        Ok(Stretch::judge(start, grown, None, || self.grown_link_hit(&grown, &FLAGS)))
     }
 
     /// A stretch of self pair `(ta, tb)`: cleared when its two links at the middle, each grown by
