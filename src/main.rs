@@ -49,7 +49,8 @@ enum Command {
         #[command(flatten)]
         model: ModelArgs,
         /// One state: `joint=value,joint=value,...` (radians / metres). With `--trajectory`, the
-        /// state the robot is in when the trajectory starts (at rest).
+        /// state the robot is in when the trajectory starts (at rest); the trajectory's joints it
+        /// leaves out start at the first point, the joints the trajectory does not name need it.
         #[arg(long, conflicts_with = "states", required_unless_present_any = ["states", "show_params", "trajectory"])]
         joints: Option<String>,
         /// A JSON-lines file of states, in order, through the node's pipeline: `{"name": [...],

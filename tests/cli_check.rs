@@ -221,3 +221,46 @@ fn a_robot_without_actuated_joints_checks_its_one_pose() {
     let lines: Vec<&str> = lines.lines().collect();
     assert_eq!(lines, [joints.trim(), joints.trim()], "every state is the one pose");
 }
+
+/// `check --trajectory` on a trajectory written the way `ros2 topic pub` examples write one for a
+/// UR arm's `joint_trajectory_controller` (flow style, quoted names, `time_from_start: {sec: 3}`
+/// with `nanosec` left out, a header with only `stamp: {sec: 0}`): read as ROS 2 reads it (a field
+/// left out is 0), the same answer as the trajectory written out in full. Such a trajectory names
+/// only the arm's joints: without the gripper's it is refused, the error saying which joint and
+/// that `--joints` gives it; with them in `--joints` (the arm starting at the first point) it is
+/// checked, the same as from a `--joints` that names every joint.
+#[test]
+fn a_trajectory_as_ros2_topic_pub_examples_write_it_is_read_as_ros_reads_it() {
+    let arm = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"];
+    let (first, last) = ([0.0, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0, 1.2, 0.3, 0.0, 0.0, 0.0]);
+    let list = |xs: &[f64]| xs.iter().map(|x| format!("{x:.1}")).collect::<Vec<_>>().join(", ");
+    let names = arm.iter().map(|n| format!("'{n}'")).collect::<Vec<_>>().join(",\n    ");
+    let short = tmp("pub_example.yaml");
+    std::fs::write(
+        &short,
+        format!(
+            "{{\n  header: {{stamp: {{sec: 0}}}},\n  joint_names: [\n    {names}\n  ],\n  points: [\n    {{positions: [{}], time_from_start: {{sec: 1}}}},\n    {{positions: [{}], time_from_start: {{sec: 3}}}}\n  ]\n}}\n",
+            list(&first),
+            list(&last)
+        ),
+    )
+    .unwrap();
+    let full = tmp("pub_example_full.json");
+    let point = |p: &[f64], sec: i32| serde_json::json!({"positions": p, "velocities": [], "accelerations": [], "effort": [], "time_from_start": {"sec": sec, "nanosec": 0}});
+    let message =
+        serde_json::json!({"header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}, "joint_names": arm, "points": [point(&first, 1), point(&last, 3)]});
+    std::fs::write(&full, message.to_string()).unwrap();
+
+    err(bin().args(["check", "--trajectory", short.to_str().unwrap(), "--json"]).output().unwrap(), &["pub_example.yaml", "finger_left_joint", "--joints"]);
+    let gripper = "finger_left_joint=0,finger_right_joint=0";
+    let everything = format!("{gripper},{}", arm.iter().zip(first).map(|(n, x)| format!("{n}={x}")).collect::<Vec<_>>().join(","));
+    let answer = ok(bin().args(["check", "--trajectory", short.to_str().unwrap(), "--json", "--joints", gripper]).output().unwrap());
+    let written_out = ok(bin().args(["check", "--trajectory", full.to_str().unwrap(), "--json", "--joints", &everything]).output().unwrap());
+    assert_eq!(answer, written_out);
+    let v: serde_json::Value = serde_json::from_str(answer.trim()).unwrap();
+    // The arm swings into the colliding pose of `COLLIDING`: met on the way, after the first
+    // point (1 s) and no later than the last (3 s).
+    assert_eq!((v["in_collision"].as_bool(), v["error"].as_str()), (Some(true), Some("")), "{v}");
+    let time = v["time"].as_f64().unwrap();
+    assert!(time > 1.0 && time <= 3.0, "{v}");
+}

@@ -5,7 +5,7 @@ use crate::ModelArgs;
 use anyhow::{anyhow, bail, Result};
 use std::io::Write;
 use std::path::Path;
-use thickness_collision::msgs::{CheckTrajectoryRequest, JointState};
+use thickness_collision::msgs::{CheckTrajectoryRequest, JointState, JointTrajectory};
 use thickness_collision::pipeline::{outcome_json, read_trajectory_file, Interpolation, APPROACH_SEGMENT};
 
 /// Checks the trajectory in `file` from `--joints` (else its first point), at rest. Prints one
@@ -19,17 +19,7 @@ pub fn check_trajectory(args: &ModelArgs, file: &Path, joints: Option<&str>, int
     let trajectory = read_trajectory_file(file).map_err(|e| anyhow!(e))?;
     let mut pipeline = super::load::pipeline(args)?;
     super::check::print_loaded(&pipeline);
-    let start = match joints {
-        Some(spec) => {
-            let (name, position) = super::check::parse_joints(spec)?;
-            JointState { name, position, ..Default::default() }
-        }
-        None => JointState {
-            name: trajectory.joint_names.clone(),
-            position: trajectory.points.first().map(|p| p.positions.clone()).unwrap_or_default(),
-            ..Default::default()
-        },
-    };
+    let start = start_state(&trajectory, joints)?;
     // A start that is not a state (a bad --joints, an empty first point) leaves the current state
     // unknown: the trajectory is then refused by the missing_joint rule, or checked from 0.
     if let Err(skip) = pipeline.joint_state(&start) {
@@ -58,7 +48,29 @@ pub fn check_trajectory(args: &ModelArgs, file: &Path, joints: Option<&str>, int
     }
     out.flush()?;
     if !response.error.is_empty() {
-        bail!("{}: {}", file.display(), response.error);
+        // A controller's trajectory names only the joints it drives (an arm's, not its gripper's):
+        // the others' positions come from `--joints`, as the node takes them from /joint_states.
+        let hint = if response.error.contains("neither in joint_names") { "; give the joints the trajectory does not name with --joints" } else { "" };
+        bail!("{}: {}{hint}", file.display(), response.error);
     }
     Ok(())
+}
+
+/// The state the trajectory starts from, at rest: `--joints`, and for every joint of the
+/// trajectory `--joints` does not name, its first point (so `--joints` may give only the joints
+/// the trajectory leaves out, a gripper's beside an arm's trajectory).
+fn start_state(trajectory: &JointTrajectory, joints: Option<&str>) -> Result<JointState> {
+    let (mut name, mut position) = match joints {
+        Some(spec) => super::check::parse_joints(spec)?,
+        None => (Vec::new(), Vec::new()),
+    };
+    if let Some(first) = trajectory.points.first().filter(|p| p.positions.len() == trajectory.joint_names.len()) {
+        for (n, x) in trajectory.joint_names.iter().zip(&first.positions) {
+            if !name.contains(n) {
+                name.push(n.clone());
+                position.push(*x);
+            }
+        }
+    }
+    Ok(JointState { name, position, ..Default::default() })
 }

@@ -32,8 +32,10 @@ fn bounded_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<V
     bounded::bounded_vec(d, MAX_JOINT_STATE_ENTRIES, "joint state field")
 }
 
-/// `builtin_interfaces/msg/Time`.
+/// `builtin_interfaces/msg/Time`. A field a file leaves out is 0, as when ROS 2 reads a message
+/// from YAML (`stamp: {sec: 5}`); CDR always carries both.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Time {
     /// Seconds.
     pub sec: i32,
@@ -60,8 +62,10 @@ pub struct ClockMsg {
     pub clock: Time,
 }
 
-/// `std_msgs/msg/Header`.
+/// `std_msgs/msg/Header`. A field a file leaves out is empty, as when ROS 2 reads a message from
+/// YAML (`header: {stamp: {sec: 0}}`); CDR always carries both.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Header {
     /// Stamp.
     pub stamp: Time,
@@ -245,8 +249,11 @@ pub struct PoseMsg {
     pub orientation: Quaternion,
 }
 
-/// `builtin_interfaces/msg/Duration`.
+/// `builtin_interfaces/msg/Duration`. A field a file leaves out is 0, as when ROS 2 reads a
+/// message from YAML (`time_from_start: {sec: 3}`, the form `ros2 topic pub` examples use); CDR
+/// always carries both.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct DurationMsg {
     /// Seconds.
     pub sec: i32,
