@@ -86,7 +86,7 @@ fn solid_marker(shape: &TargetShape, pose: &crate::math::Pose, base: Marker) -> 
         TargetShape::Sphere { radius } => round(SPHERE, 2.0 * radius, 2.0 * radius),
         TargetShape::Cylinder { half_height, radius } => round(CYLINDER, 2.0 * radius, 2.0 * half_height),
         TargetShape::Capsule { half_height, radius } => round(CYLINDER, 2.0 * radius, 2.0 * (half_height + radius)),
-        TargetShape::Polytope(hull) => {
+        TargetShape::Polytope(hull) | TargetShape::Swept { core: hull, .. } => {
             let (v, tris) = hull.vertices_and_triangles();
             let points = tris.iter().flatten().map(|&i| point(*pose * crate::math::Vector::from_array(v[i as usize]))).collect();
             Marker { kind: TRIANGLE_LIST, pose: PoseMsg::default(), scale: Vector3 { x: 1.0, y: 1.0, z: 1.0 }, color, points, ..base }

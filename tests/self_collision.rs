@@ -68,6 +68,7 @@ fn compare(name: &str, urdf: &str, srdf: &str, n: usize, seed: u64) -> Outcome {
                 kinds.push(serde_json::json!({"cylinder": [radius, half_height]}));
                 continue;
             }
+            other => panic!("a link's shape is never {other:?}"),
         };
         kinds.push(serde_json::json!("hull"));
         let (pts, tri) = hull.vertices_and_triangles();

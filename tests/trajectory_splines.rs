@@ -294,6 +294,7 @@ fn lever_bound(c: &Checker, j: usize) -> f64 {
             TargetShape::Sphere { radius } => *radius,
             TargetShape::Capsule { half_height, radius } => half_height + radius,
             TargetShape::Cylinder { half_height, radius } => half_height.hypot(*radius),
+            other => panic!("a link's shape is never {other:?}"),
         };
         let reach = t.parts.iter().map(|(shape, offset)| offset.translation.length() + own(shape)).fold(0.0, f64::max);
         let (mut chain, mut link, mut moved) = (reach, t.link, false);

@@ -293,6 +293,8 @@ impl Checker {
                     TargetShape::Cylinder { half_height, radius } => {
                         ("cylinder", (*half_height, *radius).into_pyobject(py)?.into_any(), offset).into_pyobject(py)?
                     }
+                    // Only the motion check makes swept hulls, for one question; a link is never one.
+                    TargetShape::Swept { .. } => return Err(error(format!("link '{}': a swept hull is not a link's shape", t.name))),
                 };
                 parts.append(item)?;
             }

@@ -52,6 +52,10 @@ struct Levered {
     stretch: Option<(u64, u64)>,
     world: Real,
     prefix: Vec<Real>,
+    /// When the first-order bound is the world bound: its translation part as a vector (the
+    /// velocity of the ball's centre times the half-width, world frame) and the rest of it (see
+    /// [`MotionPath::sweep`]).
+    sweep: Option<(Vector, Real)>,
 }
 
 /// A bound on `|d²p/ds²|` over every point `p` of a target and every `s`, for the levers of its
@@ -160,33 +164,34 @@ impl JointPath<'_> {
         let slot = &mut kept[ti];
         if slot.stretch != stretch {
             slot.stretch = stretch;
-            slot.world = self.find_levered(ti, poses, half, &mut slot.prefix);
+            (slot.world, slot.sweep) = self.find_levered(ti, poses, half, &mut slot.prefix);
         }
         slot.world
     }
 
-    /// [`Levered`] for target `ti` into `prefix`, returning the world bound: see
-    /// [`JointPath::bound`].
-    fn find_levered(&self, ti: usize, poses: &[Option<Pose>], half: f64, prefix: &mut Vec<Real>) -> Real {
+    /// [`Levered`] for target `ti` into `prefix`, returning the world bound (see
+    /// [`JointPath::bound`]) and, when the first-order bound is the one it is, its sweep.
+    fn find_levered(&self, ti: usize, poses: &[Option<Pose>], half: f64, prefix: &mut Vec<Real>) -> (Real, Option<(Vector, Real)>) {
         let Some(link) = poses[self.checker.targets()[ti].link] else {
             let whole = half * self.speeds[ti];
             prefix.clear();
             prefix.resize(self.checker.motion_bounds().levers[ti].len() + 1, whole);
-            return whole;
+            return (whole, None);
         };
         let radius = self.checker.motion_bounds().ball[ti].1;
         let moved = self.levers_at(ti, link, poses, half, prefix);
         prefix.iter_mut().for_each(|p| *p *= half);
         let levers = prefix.last().copied().unwrap_or(0.0);
         if !moved.first_order {
-            return levers;
+            return (levers, None);
         }
-        let moving = half * (moved.velocity.length() + moved.omega.length() * radius) + 0.5 * half * half * self.accelerations[ti];
+        let turning = half * moved.omega.length() * radius + 0.5 * half * half * self.accelerations[ti];
+        let moving = half * moved.velocity.length() + turning;
         // NaN (a bad pose) falls back to the lever bound.
         if moving < levers {
-            moving
+            (moving, Some((moved.velocity * half, turning)))
         } else {
-            levers
+            (levers, None)
         }
     }
 }
@@ -214,6 +219,15 @@ impl MotionPath for JointPath<'_> {
     /// acceleration bound of `point_acceleration`. The smaller of the two bounds is used.
     fn bound(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
         self.ensure_levered(ti, poses, mid, half)
+    }
+
+    /// The first-order bound's parts, when it is the bound: a point `p` of the link at `mid + t`
+    /// is `p + t·v + e` with `v` the velocity of the ball's centre `c` at `mid` and
+    /// `|e| <= |t|·|ω|·R + t²·A/2` (`ω × (p - c)` is the rest of `p`'s velocity; `A` the
+    /// acceleration bound): within `half`, the segment `±half·v` and a ball of the rest.
+    fn sweep(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Option<(Vector, Real)> {
+        let _ = self.ensure_levered(ti, poses, mid, half);
+        self.levered.borrow()[ti].sweep
     }
 
     fn out_of_limits(&self, s: f64) -> Vec<String> {

@@ -50,6 +50,7 @@ fn part_reach(shape: &TargetShape, offset: &Pose) -> Real {
         TargetShape::Sphere { radius } => *radius,
         TargetShape::Capsule { half_height, radius } => half_height + radius,
         TargetShape::Cylinder { half_height, radius } => half_height.hypot(*radius),
+        TargetShape::Swept { core, sweep } => core.points().iter().map(|p| p.length()).fold(0.0, Real::max) + sweep.length(),
     };
     offset.translation.length() + own
 }
@@ -93,6 +94,10 @@ pub(super) fn grow(shape: &TargetShape, pad: Real) -> TargetShape {
                 None => TargetShape::Sphere { radius: h.points().iter().map(|p| p.length()).fold(0.0, Real::max) + pad * 3f64.sqrt() },
             }
         }
+        TargetShape::Swept { core, sweep } => match grow(&TargetShape::Polytope(core.clone()), pad) {
+            TargetShape::Polytope(grown) => TargetShape::Swept { core: grown, sweep: *sweep },
+            other => TargetShape::Sphere { radius: other.bounding_radius() + sweep.length() },
+        },
     }
 }
 

@@ -29,6 +29,26 @@ impl Checker {
         })
     }
 
+    /// Whether the target at `g`'s pose, swept along the segment `±along` (world frame) and
+    /// grown by `rest` (its ladder level covering it), may touch anything it may not: "no" is
+    /// proved, "yes" may be a part the GJK could not prove apart. A part that is not a hull is
+    /// grown by `g`'s level instead (the whole bound).
+    pub(super) fn swept_link_hit(&self, g: &Grown, along: Vector, rest: Real, settings: &CollideSettings) -> bool {
+        let bounds = self.motion_bounds();
+        let level = bounds.level(rest);
+        if !(bounds.growth(level) >= rest) {
+            return self.grown_link_hit(g, settings);
+        }
+        self.targets()[g.ti].parts.iter().enumerate().any(|(pi, (_, offset))| {
+            let pose = g.pose * *offset;
+            let shape = match self.grown_part(g.ti, pi, Some(level)) {
+                TargetShape::Polytope(core) => TargetShape::Swept { core: core.clone(), sweep: pose.rotation.inverse() * along },
+                _ => self.grown_part(g.ti, pi, g.level).clone(),
+            };
+            !self.collide_target(g.ti, &Target::new(shape, pose), settings).contacts.is_empty()
+        })
+    }
+
     /// Whether any part of target `a` grown by a ball of radius `delta_a` may meet any part of
     /// `b` grown by `delta_b`, both as they are at their grown poses (see
     /// [`pair_may_meet_grown`]).

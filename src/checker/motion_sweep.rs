@@ -61,6 +61,13 @@ pub(super) trait MotionPath {
     fn bound(&self, ti: usize, _poses: &[Option<Pose>], _mid: f64, half: f64) -> Real {
         half * self.speeds()[ti]
     }
+    /// Target `ti`'s bound within `half` of `mid` split in two, when it can be: a vector `v`
+    /// (world frame) and a radius `r` such that every point of the target at every `s` in the
+    /// stretch lies within `r` of the segment from `p - v` to `p + v`, `p` where the point is at
+    /// `mid`. A link sliding along a surface is then not grown toward it by its whole speed.
+    fn sweep(&self, _ti: usize, _poses: &[Option<Pose>], _mid: f64, _half: f64) -> Option<(Vector, Real)> {
+        None
+    }
     /// The report of the state at `s` (its contacts are those of a motion found colliding there).
     fn report_at(&self, s: f64) -> StateReport;
     /// The joints out of their limits at `s` (none for a motion between link poses).
@@ -357,7 +364,14 @@ impl Checker {
             return Ok(Stretch::Clear);
         }
         let grown = grown_for(self.motion_bounds(), ti, pose, delta, path.floor(ti));
-        Ok(Stretch::judge(start, grown, None, || self.grown_link_hit(&grown, &FLAGS)))
+        // Swept along its velocity where the stretch can still be split: a link that meets
+        // nothing so is clear; one that may (the swept test proves only "apart") is split. A
+        // stretch that cannot be split asks the grown link, whose contact its report gives.
+        let sweep = if grown.tested && !grown.settled { path.sweep(ti, poses, start + half, half) } else { None };
+        Ok(Stretch::judge(start, grown, None, || match sweep {
+            Some((along, rest)) => self.swept_link_hit(&grown, along, rest, &FLAGS),
+            None => self.grown_link_hit(&grown, &FLAGS),
+        }))
     }
 
     /// A stretch of self pair `(ta, tb)`: cleared when its two links at the middle, each grown by

@@ -39,7 +39,13 @@ impl<'a> LocalPair<'a> {
     /// `pos12` is the pose of the cell's object in the target's frame.
     #[inline]
     pub fn new(target: &'a Target, cell: &ThicknessCell, pos12: &Pose) -> Self {
-        LocalPair { target, cell: CellPolytope::new(cell, pos12) }
+        // A swept hull is tested as the ball that holds it (it has no faces): the cell is seen
+        // from that ball's centre.
+        let pos12 = match &target.shape {
+            TargetShape::Swept { core, .. } => Pose::from_translation(-core.centroid) * *pos12,
+            _ => *pos12,
+        };
+        LocalPair { target, cell: CellPolytope::new(cell, &pos12) }
     }
 
     /// The SAT; `None` when apart.
@@ -57,6 +63,7 @@ impl<'a> LocalPair<'a> {
             TargetShape::Sphere { radius } => sat_sphere_cell(*radius, &self.cell).ok_or(None),
             TargetShape::Capsule { half_height, radius } => sat_capsule_cell(*half_height, *radius, &self.cell).ok_or(None),
             TargetShape::Cylinder { half_height, radius } => sat_cylinder_cell(*half_height, *radius, &self.cell).ok_or(None),
+            TargetShape::Swept { .. } => sat_sphere_cell(self.target.shape.bounding_radius(), &self.cell).ok_or(None),
         }
     }
 
@@ -76,6 +83,7 @@ impl<'a> LocalPair<'a> {
                 let start = cylinder_contact(*half_height, *radius, &self.cell)?.point1;
                 Some(contact_cylinder_cell(&self.cell, *half_height, *radius, start, 1e-10))
             }
+            TargetShape::Swept { .. } => None,
         }
     }
 }
@@ -220,7 +228,7 @@ pub(crate) fn quick_decide(view: &TargetView, cell: &ThicknessCell, recent: &mut
     if recent.separate_points(&verts) {
         return Some(false);
     }
-    if matches!(view.target.shape, TargetShape::Polytope(_)) {
+    if matches!(view.target.shape, TargetShape::Polytope(_) | TargetShape::Swept { .. }) {
         return None;
     }
     let centroid = verts.iter().copied().sum::<Vector>() / 6.0;

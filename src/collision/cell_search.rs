@@ -229,6 +229,17 @@ fn decide(view: &TargetView, cell: &ThicknessCell, recent: &mut RecentAxes, need
         let axis = view.object_in_target.rotation.inverse() * axis;
         recent.remember(axis, view.extent_along(axis));
     };
+    if let TargetShape::Swept { core, sweep } = &view.target.shape {
+        // No faces for the SAT: what the GJK cannot prove apart counts as met (a swept hull is
+        // asked only whether a stretch might meet something, and "yes" splits it).
+        return match gjk::swept_hull_cell(core, *sweep, &cell.vertices().map(|v| view.object_in_target * v)) {
+            Verdict::Apart(axis) => {
+                remember(axis.normalize());
+                (false, None)
+            }
+            Verdict::Overlap | Verdict::Unknown => (true, None),
+        };
+    }
     if let TargetShape::Polytope(hull) = &view.target.shape {
         match gjk::hull_cell(hull, &cell.vertices().map(|v| view.object_in_target * v)) {
             // With `need_sat` the SAT below confirms it and gives the least overlap.

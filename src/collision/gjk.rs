@@ -33,8 +33,15 @@ type Point = Vector;
 
 /// GJK of `hull` against the convex hull of `cell` (points in the hull's frame).
 pub(crate) fn hull_cell(hull: &ConvexHull, cell: &[Vector; 6]) -> Verdict {
+    swept_hull_cell(hull, Vector::ZERO, cell)
+}
+
+/// [`hull_cell`] for `hull` swept along the segment from `-sweep` to `sweep` (every point of it
+/// moved by `t · sweep`, `t` in `[-1, 1]`): its support along `d` is the hull's, moved by `sweep`
+/// to the side `d` points to.
+pub(crate) fn swept_hull_cell(hull: &ConvexHull, sweep: Vector, cell: &[Vector; 6]) -> Verdict {
     let support = |d: Vector| -> (Point, Real, Real) {
-        let a = hull.support_point(d);
+        let a = hull.support_point(d) + if d.dot(sweep) < 0.0 { -sweep } else { sweep };
         let (mut b, mut b_min) = (cell[0], d.dot(cell[0]));
         for p in &cell[1..] {
             let x = d.dot(*p);

@@ -29,6 +29,7 @@ impl TargetShape {
                 let side = unit(Vector::new(dir.x, dir.y, 0.0)) * *radius;
                 Vector::new(side.x, side.y, half_height.copysign(dir.z))
             }
+            TargetShape::Swept { core, sweep } => core.support_point(dir) + *sweep * if dir.dot(*sweep) < 0.0 { -1.0 } else { 1.0 },
         }
     }
 }

@@ -51,6 +51,7 @@ impl SupportMap for ShapeSupport<'_> {
                 let xy = unit(Vector::new(dir.x, dir.y, 0.0)) * *radius;
                 Vector::new(xy.x, xy.y, half_height.copysign(dir.z))
             }
+            TargetShape::Swept { .. } => self.0.support_point(dir),
         }
     }
 }
