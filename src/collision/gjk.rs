@@ -9,6 +9,7 @@
 //! every face and ~4,000 edge pairs; GJK needs a handful of support queries.
 
 use super::convex_hull::ConvexHull;
+use super::target::sweep_end;
 use crate::math::{Real, Vector};
 
 /// How far inside the tetrahedron (metres) the origin must be for a "yes".
@@ -41,7 +42,7 @@ pub(crate) fn hull_cell(hull: &ConvexHull, cell: &[Vector; 6]) -> Verdict {
 /// to the side `d` points to.
 pub(crate) fn swept_hull_cell(hull: &ConvexHull, sweep: Vector, cell: &[Vector; 6]) -> Verdict {
     let support = |d: Vector| -> (Point, Real, Real) {
-        let a = hull.support_point(d) + if d.dot(sweep) < 0.0 { -sweep } else { sweep };
+        let a = hull.support_point(d) + sweep_end(sweep, d);
         let (mut b, mut b_min) = (cell[0], d.dot(cell[0]));
         for p in &cell[1..] {
             let x = d.dot(*p);

@@ -3,7 +3,7 @@
 //! (or that the GJK could not decide: touching or razor-thin overlaps).
 
 use super::gjk::{convex_pair, Verdict};
-use super::target::{Target, TargetShape};
+use super::target::{sweep_end, Target, TargetShape};
 use crate::math::{Real, Vector};
 
 /// A contact between two parts, in the world frame.
@@ -29,7 +29,7 @@ impl TargetShape {
                 let side = unit(Vector::new(dir.x, dir.y, 0.0)) * *radius;
                 Vector::new(side.x, side.y, half_height.copysign(dir.z))
             }
-            TargetShape::Swept { core, sweep } => core.support_point(dir) + *sweep * if dir.dot(*sweep) < 0.0 { -1.0 } else { 1.0 },
+            TargetShape::Swept { core, sweep } => core.support_point(dir) + sweep_end(*sweep, dir),
         }
     }
 }

@@ -173,6 +173,17 @@ impl TargetShape {
     }
 }
 
+/// The end of the segment from `-sweep` to `sweep` extreme along `dir`: what a swept hull's
+/// support point adds to its core's (see [`TargetShape::Swept`]).
+#[inline]
+pub(crate) fn sweep_end(sweep: Vector, dir: Vector) -> Vector {
+    if dir.dot(sweep) < 0.0 {
+        -sweep
+    } else {
+        sweep
+    }
+}
+
 /// A posed convex shape: a robot link (or part of one) in the world.
 #[derive(Clone, Debug)]
 pub struct Target {
