@@ -76,6 +76,8 @@ fn main() {
         tolerance: Vec::new(),
     };
     let rest = vec![0.0; n];
+    // As the node does at start (see benches/motion.rs).
+    checker.prepare_motion_checks();
     for (q0, q1, v0, v1) in edges.iter().take(100) {
         let _ = (checker.check_motion(q0, q1), checker.check_spline(&spline(q0, q1, v0, v1)));
     }

@@ -26,6 +26,8 @@ use std::cell::RefCell;
 /// A motion in joint space: `q0 + s·delta`, link poses by forward kinematics.
 struct JointPath<'a> {
     checker: &'a Checker,
+    /// The robot's base in the world.
+    base: Pose,
     q0: &'a [f64],
     delta: Vec<f64>,
     speeds: Vec<Real>,
@@ -36,10 +38,26 @@ struct JointPath<'a> {
     /// levers) at `[k]`; the last is its speed. A self pair's quick relative bound is such a
     /// prefix times the half-width.
     steady_sums: Vec<Vec<Real>>,
+    /// Per target, at `[k]`: the acceleration bound of `point_acceleration` over its first `k`
+    /// joints alone, what its points do in the frame above them (a self pair's relative
+    /// first-order bound; see [`JointPath::pair_bound`]).
+    relative_accelerations: Vec<Vec<Real>>,
     /// Per target, the bounds last found for it (see [`Levered`]): the sweep examines a
     /// stretch's targets and pairs together, so a pair asks at the stretch its targets just
     /// answered.
     levered: RefCell<Vec<Levered>>,
+    /// Every joint's axis in the world at the stretch the targets were last asked at: each
+    /// target's pass over its joints would turn the same axes again.
+    axes: RefCell<StretchAxes>,
+}
+
+/// See [`JointPath::axes`].
+#[derive(Default)]
+struct StretchAxes {
+    /// The bits of the stretch's middle and half-width (`None`: none yet).
+    stretch: Option<(u64, u64)>,
+    /// Per joint (zero when its child link has no pose).
+    axes: Vec<Vector>,
 }
 
 /// What one pass over a target's joints gives at a stretch's middle: the world bound (the
@@ -56,6 +74,10 @@ struct Levered {
     /// velocity of the ball's centre times the half-width, world frame) and the rest of it (see
     /// [`MotionPath::sweep`]).
     sweep: Option<(Vector, Real)>,
+    /// At `[k]`: the angular velocity of the link and the velocity of its ball's centre that its
+    /// first `k` joints give it (world frame, per unit of `s`); `None` from the first moving
+    /// joint whose child has no pose on.
+    moving: Vec<Option<(Vector, Vector)>>,
 }
 
 /// A bound on `|d²p/ds²|` over every point `p` of a target and every `s`, for the levers of its
@@ -114,8 +136,18 @@ impl JointPath<'_> {
     /// link's rotation and of its ball's centre.
     /// `prefix` gets `Σ_j |Δq_j| · lever_j` over the first `k` joints at `[k]`; the last is the
     /// whole sum.
-    fn levers_at(&self, ti: usize, link: Pose, poses: &[Option<Pose>], half: f64, prefix: &mut Vec<Real>) -> Moved {
+    fn levers_at(&self, ti: usize, link: Pose, poses: &[Option<Pose>], (mid, half): (f64, f64), kept: &mut Levered) -> Moved {
         let robot = self.checker.robot();
+        let mut axes = self.axes.borrow_mut();
+        let stretch = Some((mid.to_bits(), half.to_bits()));
+        if axes.stretch != stretch {
+            axes.stretch = stretch;
+            axes.axes.clear();
+            axes.axes.extend(robot.joints.iter().map(|joint| match poses[joint.child] {
+                Some(child) => child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z),
+                None => Vector::ZERO,
+            }));
+        }
         let bounds = self.checker.motion_bounds();
         let reach = bounds.reach[ti];
         let (centre, radius) = bounds.ball[ti];
@@ -123,15 +155,20 @@ impl JointPath<'_> {
         // Σ_i |Δq_i| r_ik over the joints between the current one and the link.
         let mut below = 0.0;
         let mut moved = Moved { omega: Vector::ZERO, velocity: Vector::ZERO, first_order: true };
+        let Levered { prefix, moving, .. } = kept;
         prefix.clear();
         prefix.push(0.0);
+        moving.clear();
+        moving.push(Some((Vector::ZERO, Vector::ZERO)));
         let mut sum = 0.0;
         for (&(j, _), &r) in bounds.levers[ti].iter().zip(&bounds.steady[ti]) {
             let d = self.delta[j].abs();
             let joint = &robot.joints[j];
             let lever = match (joint.kind, poses[joint.child]) {
                 (JointKind::Revolute | JointKind::Continuous, Some(child)) => {
-                    let (axis, off_axis) = axis_and_offset(joint, &child, &link);
+                    let axis = axes.axes[j];
+                    let rel = link.translation - child.translation;
+                    let off_axis = (rel - axis * rel.dot(axis)).length();
                     moved.omega += axis * self.delta[j];
                     moved.velocity += axis.cross(centre - child.translation) * self.delta[j];
                     // From the axis to the link's origin plus its reach, or to its ball's centre
@@ -151,6 +188,7 @@ impl JointPath<'_> {
             };
             sum += d * lever;
             prefix.push(sum);
+            moving.push(moved.first_order.then_some((moved.omega, moved.velocity)));
             below += d * r;
         }
         moved
@@ -164,24 +202,27 @@ impl JointPath<'_> {
         let slot = &mut kept[ti];
         if slot.stretch != stretch {
             slot.stretch = stretch;
-            (slot.world, slot.sweep) = self.find_levered(ti, poses, half, &mut slot.prefix);
+            (slot.world, slot.sweep) = self.find_levered(ti, poses, (mid, half), slot);
         }
         slot.world
     }
 
-    /// [`Levered`] for target `ti` into `prefix`, returning the world bound (see
+    /// [`Levered`]'s prefixes for target `ti` into `kept`, returning the world bound (see
     /// [`JointPath::bound`]) and, when the first-order bound is the one it is, its sweep.
-    fn find_levered(&self, ti: usize, poses: &[Option<Pose>], half: f64, prefix: &mut Vec<Real>) -> (Real, Option<(Vector, Real)>) {
+    fn find_levered(&self, ti: usize, poses: &[Option<Pose>], (mid, half): (f64, f64), kept: &mut Levered) -> (Real, Option<(Vector, Real)>) {
         let Some(link) = poses[self.checker.targets()[ti].link] else {
             let whole = half * self.speeds[ti];
-            prefix.clear();
-            prefix.resize(self.checker.motion_bounds().levers[ti].len() + 1, whole);
+            let joints = self.checker.motion_bounds().levers[ti].len() + 1;
+            kept.prefix.clear();
+            kept.prefix.resize(joints, whole);
+            kept.moving.clear();
+            kept.moving.resize(joints, None);
             return (whole, None);
         };
         let radius = self.checker.motion_bounds().ball[ti].1;
-        let moved = self.levers_at(ti, link, poses, half, prefix);
-        prefix.iter_mut().for_each(|p| *p *= half);
-        let levers = prefix.last().copied().unwrap_or(0.0);
+        let moved = self.levers_at(ti, link, poses, (mid, half), kept);
+        kept.prefix.iter_mut().for_each(|p| *p *= half);
+        let levers = kept.prefix.last().copied().unwrap_or(0.0);
         if !moved.first_order {
             return (levers, None);
         }
@@ -196,14 +237,37 @@ impl JointPath<'_> {
     }
 }
 
+impl JointPath<'_> {
+    /// Target `t`'s bound within `half` over its first `k` joints alone (`kept`: its
+    /// [`Levered`] at the stretch), in the frame of the link above them: the smaller of their
+    /// lever sum and their first-order bound. In that frame the chain from it down to the link
+    /// is fixed at its base, so the first-order bound of `bound` holds with their velocities and
+    /// their own acceleration bound.
+    fn relative_bound(&self, kept: &Levered, t: usize, k: usize, half: f64) -> Real {
+        let levers = kept.prefix[k];
+        let Some((omega, velocity)) = kept.moving[k] else {
+            return levers;
+        };
+        let radius = self.checker.motion_bounds().ball[t].1;
+        let first_order = half * (velocity.length() + omega.length() * radius) + 0.5 * half * half * self.relative_accelerations[t][k];
+        // NaN (a bad pose) keeps the lever sum.
+        if first_order < levers {
+            first_order
+        } else {
+            levers
+        }
+    }
+}
+
 impl MotionPath for JointPath<'_> {
     fn speeds(&self) -> &[Real] {
         &self.speeds
     }
 
+    /// Both ends were validated (`Checker::joint_path`): every position between is finite.
     fn link_poses(&self, s: f64) -> Result<Vec<Option<Pose>>, String> {
-        let poses = self.checker.robot().forward_kinematics(&self.at(s), self.checker.base_pose()).map_err(|e| e.to_string())?;
-        Ok(poses.iter().map(|p| Some(pose_from_isometry(p))).collect())
+        let frames = &self.checker.motion_bounds().frames;
+        Ok(self.checker.robot().forward_poses(frames, |j| self.q0[j] + s * self.delta[j], self.base))
     }
 
     /// Tighter than `half · speed` where the link is nearer a joint's axis than the lever bound
@@ -239,8 +303,9 @@ impl MotionPath for JointPath<'_> {
     }
 
     /// In the frame of the last link upstream of both: only the joints that move one of the two
-    /// and not the other count (a joint above both turns the pair as one body), each lever
-    /// tightened at the middle as for `bound`; the world bounds when those are smaller in sum.
+    /// and not the other count (a joint above both turns the pair as one body), each link's the
+    /// smaller of their levers tightened at the middle and their first-order bound, as for
+    /// `bound`; the world bounds when those are smaller in sum.
     fn pair_bound(&self, a: usize, b: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> (Real, Real) {
         let targets = self.checker.targets();
         if poses[targets[a].link].is_none() || poses[targets[b].link].is_none() {
@@ -250,7 +315,8 @@ impl MotionPath for JointPath<'_> {
         let kept = self.levered.borrow();
         let (la, lb) = (&kept[a], &kept[b]);
         let bounds = self.checker.motion_bounds();
-        let relative = (la.prefix[bounds.unshared(a, b)], lb.prefix[bounds.unshared(b, a)]);
+        let (ka, kb) = (bounds.unshared(a, b), bounds.unshared(b, a));
+        let relative = (self.relative_bound(la, a, ka, half), self.relative_bound(lb, b, kb, half));
         let world = (la.world, lb.world);
         if relative.0 + relative.1 <= world.0 + world.1 {
             relative
@@ -324,8 +390,32 @@ impl Checker {
             .collect();
         let speeds: Vec<Real> = steady_sums.iter().map(|sums| sums.last().copied().unwrap_or(0.0)).collect();
         let accelerations = bounds.levers.iter().zip(&speeds).map(|(l, speed)| point_acceleration(robot, l, &delta, *speed)).collect();
-        let levered = RefCell::new((0..speeds.len()).map(|_| Levered::default()).collect());
-        Ok(JointPath { checker: self, q0, delta, speeds, accelerations, steady_sums, levered })
+        let relative_accelerations = bounds
+            .levers
+            .iter()
+            .zip(&steady_sums)
+            .map(|(l, sums)| (0..=l.len()).map(|k| point_acceleration(robot, &l[..k], &delta, sums[k])).collect())
+            .collect();
+        // Sized once: growing them push by push was 3 % of a motion's time on the wall.
+        let levered = RefCell::new(
+            bounds
+                .levers
+                .iter()
+                .map(|l| Levered { prefix: Vec::with_capacity(l.len() + 1), moving: Vec::with_capacity(l.len() + 1), ..Levered::default() })
+                .collect(),
+        );
+        Ok(JointPath {
+            checker: self,
+            base: pose_from_isometry(self.base_pose()),
+            q0,
+            delta,
+            speeds,
+            accelerations,
+            relative_accelerations,
+            steady_sums,
+            levered,
+            axes: RefCell::default(),
+        })
     }
 }
 
@@ -373,6 +463,36 @@ mod tests {
     fn random_state(robot: &RobotModel, draw: &mut impl FnMut(f64, f64) -> f64) -> Vec<f64> {
         let pi = std::f64::consts::PI;
         robot.joints.iter().map(|j| if j.limits.iter().all(|l| l.is_finite()) { draw(j.limits[0], j.limits[1]) } else { draw(-pi, pi) }).collect()
+    }
+
+    /// The motion loop's forward kinematics (glam, unvalidated) poses every link where the
+    /// state check's (nalgebra) does, over random states of the bundled arm (revolute,
+    /// continuous, prismatic and mimic joints) on a base that is not the identity.
+    #[test]
+    fn the_loops_forward_kinematics_is_the_state_checks() {
+        let c = arm();
+        let robot = c.robot();
+        let mut rng = oorandom::Rand64::new(41);
+        let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
+        let frames = robot.pose_kinematics();
+        let mut largest = 0.0f64;
+        for _ in 0..200 {
+            let q = random_state(robot, &mut draw);
+            let base = nalgebra::Isometry3::new(
+                nalgebra::Vector3::new(draw(-1.0, 1.0), draw(-1.0, 1.0), draw(0.0, 1.0)),
+                nalgebra::Vector3::new(draw(-1.0, 1.0), draw(-1.0, 1.0), draw(-3.0, 3.0)),
+            );
+            let expected = robot.forward_kinematics(&q, &base).unwrap();
+            let got = robot.forward_poses(&frames, |j| q[j], pose_from_isometry(&base));
+            assert_eq!(got.len(), expected.len());
+            for (g, e) in got.iter().zip(&expected) {
+                let (g, e) = (g.expect("every link posed"), pose_from_isometry(e));
+                for p in [Vector::X, Vector::Y, Vector::Z, Vector::new(0.3, -0.2, 0.5)] {
+                    largest = largest.max((g * p - e * p).length());
+                }
+            }
+        }
+        assert!(largest < 1e-12, "largest difference {largest} m");
     }
 
     /// The self pairs' bound, checked directly: within a stretch, no distance between a point of

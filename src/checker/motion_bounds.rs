@@ -4,7 +4,7 @@
 use super::link_targets::LinkTargets;
 use crate::collision::{ConvexHull, TargetShape};
 use crate::math::{pose_from_isometry, Pose, Real, Vector};
-use crate::model::{JointKind, RobotModel};
+use crate::model::{JointKind, PoseKinematics, RobotModel};
 use std::sync::{Arc, OnceLock};
 
 /// Rungs of the growth ladder per doubling: growth `base · 2^(level / RUNGS)`. The growth used is
@@ -37,6 +37,8 @@ pub(crate) struct MotionBounds {
     pub(super) ball: Vec<(Vector, Real)>,
     /// Per target, per part, per level: the part grown by `base · 2^level`.
     pub(super) grown: Vec<Vec<Vec<OnceLock<TargetShape>>>>,
+    /// The joints' frames, for the motion loop's forward kinematics.
+    pub(super) frames: PoseKinematics,
     /// Per pair of targets `(x, y)`, at `x * targets + y`: see [`MotionBounds::unshared`].
     unshared: Vec<usize>,
     /// Growth of level 0: half the tolerance, so a level under the tolerance exists.
@@ -160,7 +162,20 @@ impl MotionBounds {
                 levers[x].iter().take_while(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).count()
             })
             .collect();
-        MotionBounds { levers, steady, reach: reaches, ball, grown, unshared, base: tolerance / 2.0 }
+        MotionBounds { levers, steady, reach: reaches, ball, grown, frames: robot.pose_kinematics(), unshared, base: tolerance / 2.0 }
+    }
+
+    /// Builds every part's grown shapes up to the level that covers `up_to` (see
+    /// [`crate::checker::Checker::prepare_motion_checks`]).
+    pub(super) fn build_ladder(&self, targets: &[LinkTargets], up_to: Real) {
+        let top = self.level(up_to);
+        for (t, grown) in targets.iter().zip(&self.grown) {
+            for ((shape, _), levels) in t.parts.iter().zip(grown) {
+                for (level, slot) in levels.iter().enumerate().take(top + 1) {
+                    let _ = slot.get_or_init(|| grow(shape, self.growth(level)));
+                }
+            }
+        }
     }
 
     /// How many of target `x`'s joints (nearest first) come before the first that moves target

@@ -20,7 +20,7 @@ pub(crate) const MAX_SUBINTERVALS: u64 = 1 << 20;
 /// link tests, each cheaper). With hulls grown by balls (no cube corners) the balance moved:
 /// 0.3, 0.15, 0.08, 0.06, 0.04, 0.02 m gave 4.51, 4.22, 4.08, 4.06, 4.03, 4.20 state checks per
 /// motion on the peer world and 7.19, 6.57, 6.41, 6.40, 6.47, 7.22 on the wall (10,000 motions).
-const MAX_TESTED_GROWTH: Real = 0.06;
+pub(super) const MAX_TESTED_GROWTH: Real = 0.06;
 
 /// The growth the fastest link's steady lever bound (its speed times the half-width) is brought
 /// to, about, by the equal stretches a motion is first split into (metres). On the motion

@@ -27,5 +27,6 @@ pub use self::mesh_file::{read_mesh, MeshData, MeshFileError};
 pub use self::package::{PackageError, PackageResolver};
 pub use self::params::{InputFiles, MissingJoint, Padding, Params, ParamsError, PoseSource, ServiceMapping, ThinSurfaces};
 pub use self::params_file::{node_fqn, LoadedParams, DEFAULT_NODE_FQN};
+pub(crate) use self::robot::PoseKinematics;
 pub use self::robot::{GeometrySpec, JointKind, JointModel, LinkGeometry, LinkModel, Mimic, ModelError, PositionsError, RobotModel};
 pub use self::srdf::{Srdf, SrdfError};

@@ -210,7 +210,48 @@ pub struct RobotModel {
     pub(super) joint_index: HashMap<String, usize>,
 }
 
+/// The joints' origins and axes in the geometry's types (see [`RobotModel::forward_poses`]).
+#[derive(Clone, Debug)]
+pub(crate) struct PoseKinematics {
+    origins: Vec<crate::math::Pose>,
+    axes: Vec<crate::math::Vector>,
+}
+
 impl RobotModel {
+    /// The joints' frames for [`RobotModel::forward_poses`].
+    pub(crate) fn pose_kinematics(&self) -> PoseKinematics {
+        PoseKinematics {
+            origins: self.joints.iter().map(|j| crate::math::pose_from_isometry(&j.origin)).collect(),
+            axes: self.joints.iter().map(|j| crate::math::Vector::new(j.axis.x, j.axis.y, j.axis.z)).collect(),
+        }
+    }
+
+    /// [`RobotModel::forward_kinematics`] in the geometry's types, for a loop that poses the
+    /// robot at every step (a motion check): `position(j)` is joint `j`'s position, every one
+    /// finite (the caller has validated the states it interpolates). Every link gets a pose.
+    pub(crate) fn forward_poses(&self, frames: &PoseKinematics, position: impl Fn(usize) -> f64, base: crate::math::Pose) -> Vec<Option<crate::math::Pose>> {
+        use crate::math::{Pose, Rotation};
+        let mut poses = vec![Some(Pose::IDENTITY); self.links.len()];
+        poses[self.root] = Some(base);
+        for &ji in &self.order {
+            let j = &self.joints[ji];
+            let q = match j.mimic {
+                Some(m) => m.multiplier * position(m.joint) + m.offset,
+                None => position(ji),
+            };
+            // The order places every parent first: its pose is set.
+            let origin = poses[j.parent].unwrap_or(Pose::IDENTITY) * frames.origins[ji];
+            poses[j.child] = Some(match j.kind {
+                JointKind::Revolute | JointKind::Continuous => {
+                    origin * Pose::from_parts(crate::math::Vector::ZERO, Rotation::from_axis_angle(frames.axes[ji], q))
+                }
+                JointKind::Prismatic => origin * Pose::from_parts(frames.axes[ji] * q, Rotation::IDENTITY),
+                JointKind::Fixed | JointKind::Floating | JointKind::Planar => origin,
+            });
+        }
+        poses
+    }
+
     /// The joint whose child link `link` is; `None` for the root (or an index out of range).
     pub(crate) fn parent_joint(&self, link: usize) -> Option<usize> {
         self.parent_joint.get(link).copied().flatten()

@@ -171,6 +171,13 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     let params = params.with_overrides(&opts.ros_args.params)?;
     // The robot may come as a robot_description: an SRDF meant for it waits for it.
     let pipeline = Pipeline::new_expecting_description(params)?;
+    // The motion checks' grown links, built beside the start rather than by the first requests
+    // (a request that needs one first waits only for that one).
+    let prepared = Arc::clone(pipeline.checker());
+    let _detached = std::thread::Builder::new()
+        .name("motion ladder".into())
+        .spawn(move || prepared.prepare_motion_checks())
+        .context("cannot start the motion ladder's thread")?;
     let (dp, domain, discovery) = participant()?;
     let context = Context::from_domain_participant(dp).map_err(|e| anyhow!("ROS context: {e:?}"))?;
     let namespace = opts.ros_args.namespace.clone().unwrap_or_else(|| "/".into());
