@@ -495,6 +495,35 @@ mod tests {
         assert!(largest < 1e-12, "largest difference {largest} m");
     }
 
+    /// `prepare_motion_checks` builds every rung up to the largest tested growth, for every
+    /// part, and nothing above it; motions then answer as they do on a checker that builds its
+    /// rungs on first use.
+    #[test]
+    fn a_prepared_checker_has_its_ladder_and_answers_as_an_unprepared_one() {
+        let (prepared, lazy) = (arm(), arm());
+        prepared.prepare_motion_checks();
+        let bounds = prepared.motion_bounds();
+        let top = bounds.level(crate::checker::motion_sweep::MAX_TESTED_GROWTH);
+        assert!(top > 0 && bounds.growth(top) >= crate::checker::motion_sweep::MAX_TESTED_GROWTH);
+        for levels in bounds.grown.iter().flatten() {
+            assert!(levels.iter().take(top + 1).all(|l| l.get().is_some()));
+            assert!(levels.iter().skip(top + 1).all(|l| l.get().is_none()));
+        }
+        let robot = prepared.robot();
+        let mut rng = oorandom::Rand64::new(47);
+        let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
+        let mut colliding = 0;
+        for _ in 0..60 {
+            let (q0, q1) = (random_state(robot, &mut draw), random_state(robot, &mut draw));
+            let (mut a, mut b) = (prepared.check_motion(&q0, &q1), lazy.check_motion(&q0, &q1));
+            // The report's own clock is the one field that may differ.
+            (a.report.check_seconds, b.report.check_seconds) = (0.0, 0.0);
+            assert_eq!(a, b);
+            colliding += usize::from(a.report.in_collision);
+        }
+        assert!(colliding > 0, "some motions collide");
+    }
+
     /// The self pairs' bound, checked directly: within a stretch, no distance between a point of
     /// one link of a pair and a point of the other changes by more than the two bounds' sum (so
     /// two links grown by them at the middle, apart, stay apart), over random motions of the
