@@ -37,15 +37,17 @@ struct JointPath<'a> {
     /// Per target: `Σ_j |Δq_j| r_j` over its first `k` joints (nearest first, the steady
     /// levers) at `[k]`; the last is its speed. A self pair's quick relative bound is such a
     /// prefix times the half-width.
-    steady_sums: Vec<Vec<Real>>,
+    /// (Every per-target prefix array of a motion is one flat array: see
+    /// `MotionBounds::prefix_start`.)
+    steady_sums: Vec<Real>,
     /// Per target, at `[k]`: the acceleration bound of `point_acceleration` over its first `k`
     /// joints alone, what its points do in the frame above them (a self pair's relative
     /// first-order bound; see [`JointPath::pair_bound`]).
-    relative_accelerations: Vec<Vec<Real>>,
+    relative_accelerations: Vec<Real>,
     /// Per target, the bounds last found for it (see [`Levered`]): the sweep examines a
     /// stretch's targets and pairs together, so a pair asks at the stretch its targets just
     /// answered.
-    levered: RefCell<Vec<Levered>>,
+    levered: RefCell<Levered>,
     /// Every joint's axis in the world at the stretch the targets were last asked at: each
     /// target's pass over its joints would turn the same axes again.
     axes: RefCell<StretchAxes>,
@@ -60,24 +62,30 @@ struct StretchAxes {
     axes: Vec<Vector>,
 }
 
-/// What one pass over a target's joints gives at a stretch's middle: the world bound (the
-/// smaller of the lever sum and the first-order bound), and the lever sums of its nearest
-/// joints, `prefix[k]` over the first `k` (times the half-width). A self pair's relative bound
-/// is such a prefix: the joints a pair's two links share are the end of each one's list.
-#[derive(Default)]
+/// What one pass over a target's joints gives at a stretch's middle, per target: the world
+/// bound (the smaller of the lever sum and the first-order bound), and the lever sums of its
+/// nearest joints, `prefix[k]` over the first `k` (times the half-width). A self pair's
+/// relative bound is such a prefix: the joints a pair's two links share are the end of each
+/// one's list. The prefixes of every target are one flat array (`MotionBounds::prefix_start`).
 struct Levered {
-    /// The stretch they are for: the bits of its middle and half-width (`None`: none yet).
-    stretch: Option<(u64, u64)>,
-    world: Real,
+    bounds: Vec<TargetBound>,
     prefix: Vec<Real>,
-    /// When the first-order bound is the world bound: its translation part as a vector (the
-    /// velocity of the ball's centre times the half-width, world frame) and the rest of it (see
-    /// [`MotionPath::sweep`]).
-    sweep: Option<(Vector, Real)>,
     /// At `[k]`: the angular velocity of the link and the velocity of its ball's centre that its
     /// first `k` joints give it (world frame, per unit of `s`); `None` from the first moving
     /// joint whose child has no pose on.
     moving: Vec<Option<(Vector, Vector)>>,
+}
+
+/// A target's world bound at a stretch (see [`Levered`]).
+#[derive(Clone, Copy, Default)]
+struct TargetBound {
+    /// The stretch it is for: the bits of its middle and half-width (`None`: none yet).
+    stretch: Option<(u64, u64)>,
+    world: Real,
+    /// When the first-order bound is the world bound: its translation part as a vector (the
+    /// velocity of the ball's centre times the half-width, world frame) and the rest of it (see
+    /// [`MotionPath::sweep`]).
+    sweep: Option<(Vector, Real)>,
 }
 
 /// A bound on `|d²p/ds²|` over every point `p` of a target and every `s`, for the levers of its
@@ -136,7 +144,15 @@ impl JointPath<'_> {
     /// link's rotation and of its ball's centre.
     /// `prefix` gets `Σ_j |Δq_j| · lever_j` over the first `k` joints at `[k]`; the last is the
     /// whole sum.
-    fn levers_at(&self, ti: usize, link: Pose, poses: &[Option<Pose>], (mid, half): (f64, f64), kept: &mut Levered) -> Moved {
+    fn levers_at(
+        &self,
+        ti: usize,
+        link: Pose,
+        poses: &[Option<Pose>],
+        (mid, half): (f64, f64),
+        prefix: &mut [Real],
+        moving: &mut [Option<(Vector, Vector)>],
+    ) -> Moved {
         let robot = self.checker.robot();
         let mut axes = self.axes.borrow_mut();
         let stretch = Some((mid.to_bits(), half.to_bits()));
@@ -155,13 +171,10 @@ impl JointPath<'_> {
         // Σ_i |Δq_i| r_ik over the joints between the current one and the link.
         let mut below = 0.0;
         let mut moved = Moved { omega: Vector::ZERO, velocity: Vector::ZERO, first_order: true };
-        let Levered { prefix, moving, .. } = kept;
-        prefix.clear();
-        prefix.push(0.0);
-        moving.clear();
-        moving.push(Some((Vector::ZERO, Vector::ZERO)));
+        prefix[0] = 0.0;
+        moving[0] = Some((Vector::ZERO, Vector::ZERO));
         let mut sum = 0.0;
-        for (&(j, _), &r) in bounds.levers[ti].iter().zip(&bounds.steady[ti]) {
+        for (k, (&(j, _), &r)) in bounds.levers[ti].iter().zip(&bounds.steady[ti]).enumerate() {
             let d = self.delta[j].abs();
             let joint = &robot.joints[j];
             let lever = match (joint.kind, poses[joint.child]) {
@@ -187,8 +200,8 @@ impl JointPath<'_> {
                 }
             };
             sum += d * lever;
-            prefix.push(sum);
-            moving.push(moved.first_order.then_some((moved.omega, moved.velocity)));
+            prefix[k + 1] = sum;
+            moving[k + 1] = moved.first_order.then_some((moved.omega, moved.velocity));
             below += d * r;
         }
         moved
@@ -199,30 +212,38 @@ impl JointPath<'_> {
     fn ensure_levered(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Real {
         let stretch = Some((mid.to_bits(), half.to_bits()));
         let mut kept = self.levered.borrow_mut();
-        let slot = &mut kept[ti];
+        let Levered { bounds, prefix, moving } = &mut *kept;
+        let slot = &mut bounds[ti];
         if slot.stretch != stretch {
-            slot.stretch = stretch;
-            (slot.world, slot.sweep) = self.find_levered(ti, poses, (mid, half), slot);
+            let start = &self.checker.motion_bounds().prefix_start;
+            let range = start[ti]..start[ti + 1];
+            let (world, sweep) = self.find_levered(ti, poses, (mid, half), &mut prefix[range.clone()], &mut moving[range]);
+            *slot = TargetBound { stretch, world, sweep };
         }
         slot.world
     }
 
-    /// [`Levered`]'s prefixes for target `ti` into `kept`, returning the world bound (see
-    /// [`JointPath::bound`]) and, when the first-order bound is the one it is, its sweep.
-    fn find_levered(&self, ti: usize, poses: &[Option<Pose>], (mid, half): (f64, f64), kept: &mut Levered) -> (Real, Option<(Vector, Real)>) {
+    /// [`Levered`]'s prefixes for target `ti` into `prefix` and `moving` (its own), returning
+    /// the world bound (see [`JointPath::bound`]) and, when the first-order bound is the one it
+    /// is, its sweep.
+    fn find_levered(
+        &self,
+        ti: usize,
+        poses: &[Option<Pose>],
+        (mid, half): (f64, f64),
+        prefix: &mut [Real],
+        moving: &mut [Option<(Vector, Vector)>],
+    ) -> (Real, Option<(Vector, Real)>) {
         let Some(link) = poses[self.checker.targets()[ti].link] else {
             let whole = half * self.speeds[ti];
-            let joints = self.checker.motion_bounds().levers[ti].len() + 1;
-            kept.prefix.clear();
-            kept.prefix.resize(joints, whole);
-            kept.moving.clear();
-            kept.moving.resize(joints, None);
+            prefix.fill(whole);
+            moving.fill(None);
             return (whole, None);
         };
         let radius = self.checker.motion_bounds().ball[ti].1;
-        let moved = self.levers_at(ti, link, poses, (mid, half), kept);
-        kept.prefix.iter_mut().for_each(|p| *p *= half);
-        let levers = kept.prefix.last().copied().unwrap_or(0.0);
+        let moved = self.levers_at(ti, link, poses, (mid, half), prefix, moving);
+        prefix.iter_mut().for_each(|p| *p *= half);
+        let levers = prefix.last().copied().unwrap_or(0.0);
         if !moved.first_order {
             return (levers, None);
         }
@@ -238,18 +259,20 @@ impl JointPath<'_> {
 }
 
 impl JointPath<'_> {
-    /// Target `t`'s bound within `half` over its first `k` joints alone (`kept`: its
-    /// [`Levered`] at the stretch), in the frame of the link above them: the smaller of their
-    /// lever sum and their first-order bound. In that frame the chain from it down to the link
-    /// is fixed at its base, so the first-order bound of `bound` holds with their velocities and
-    /// their own acceleration bound.
+    /// Target `t`'s bound within `half` over its first `k` joints alone (`kept`: the
+    /// [`Levered`] of the stretch, found for `t`), in the frame of the link above them: the
+    /// smaller of their lever sum and their first-order bound. In that frame the chain from it
+    /// down to the link is fixed at its base, so the first-order bound of `bound` holds with
+    /// their velocities and their own acceleration bound.
     fn relative_bound(&self, kept: &Levered, t: usize, k: usize, half: f64) -> Real {
-        let levers = kept.prefix[k];
-        let Some((omega, velocity)) = kept.moving[k] else {
+        let bounds = self.checker.motion_bounds();
+        let at = bounds.prefix_start[t] + k;
+        let levers = kept.prefix[at];
+        let Some((omega, velocity)) = kept.moving[at] else {
             return levers;
         };
-        let radius = self.checker.motion_bounds().ball[t].1;
-        let first_order = half * (velocity.length() + omega.length() * radius) + 0.5 * half * half * self.relative_accelerations[t][k];
+        let radius = bounds.ball[t].1;
+        let first_order = half * (velocity.length() + omega.length() * radius) + 0.5 * half * half * self.relative_accelerations[at];
         // NaN (a bad pose) keeps the lever sum.
         if first_order < levers {
             first_order
@@ -291,7 +314,7 @@ impl MotionPath for JointPath<'_> {
     /// acceleration bound): within `half`, the segment `±half·v` and a ball of the rest.
     fn sweep(&self, ti: usize, poses: &[Option<Pose>], mid: f64, half: f64) -> Option<(Vector, Real)> {
         let _ = self.ensure_levered(ti, poses, mid, half);
-        self.levered.borrow()[ti].sweep
+        self.levered.borrow().bounds[ti].sweep
     }
 
     fn out_of_limits(&self, s: f64) -> Vec<String> {
@@ -313,11 +336,10 @@ impl MotionPath for JointPath<'_> {
         }
         let _ = (self.ensure_levered(a, poses, mid, half), self.ensure_levered(b, poses, mid, half));
         let kept = self.levered.borrow();
-        let (la, lb) = (&kept[a], &kept[b]);
         let bounds = self.checker.motion_bounds();
         let (ka, kb) = (bounds.unshared(a, b), bounds.unshared(b, a));
-        let relative = (self.relative_bound(la, a, ka, half), self.relative_bound(lb, b, kb, half));
-        let world = (la.world, lb.world);
+        let relative = (self.relative_bound(&kept, a, ka, half), self.relative_bound(&kept, b, kb, half));
+        let world = (kept.bounds[a].world, kept.bounds[b].world);
         if relative.0 + relative.1 <= world.0 + world.1 {
             relative
         } else {
@@ -328,7 +350,8 @@ impl MotionPath for JointPath<'_> {
     /// The relative bounds of [`JointPath::pair_bound`] alone.
     fn pair_bound_quick(&self, a: usize, b: usize, _poses: &[Option<Pose>], _mid: f64, half: f64) -> (Real, Real) {
         let bounds = self.checker.motion_bounds();
-        (half * self.steady_sums[a][bounds.unshared(a, b)], half * self.steady_sums[b][bounds.unshared(b, a)])
+        let start = &bounds.prefix_start;
+        (half * self.steady_sums[start[a] + bounds.unshared(a, b)], half * self.steady_sums[start[b] + bounds.unshared(b, a)])
     }
 }
 
@@ -375,35 +398,22 @@ impl Checker {
         let bounds = self.motion_bounds();
         // Per target: Σ_j |Δq_j| r_jk (the steady levers), the speed bound of its points per
         // unit of s.
-        let steady_sums: Vec<Vec<Real>> = bounds
-            .levers
-            .iter()
-            .zip(&bounds.steady)
-            .map(|(l, steady)| {
-                std::iter::once(0.0)
-                    .chain(l.iter().zip(steady).scan(0.0, |sum, ((j, _), r)| {
-                        *sum += delta[*j].abs() * r;
-                        Some(*sum)
-                    }))
-                    .collect()
-            })
-            .collect();
-        let speeds: Vec<Real> = steady_sums.iter().map(|sums| sums.last().copied().unwrap_or(0.0)).collect();
+        // One allocation per array, not one per target: a motion's setup was 3-5 % of its time.
+        let prefixes = bounds.prefix_start.last().copied().unwrap_or(0);
+        let (mut steady_sums, mut relative_accelerations) = (Vec::with_capacity(prefixes), Vec::with_capacity(prefixes));
+        for (l, steady) in bounds.levers.iter().zip(&bounds.steady) {
+            let first = steady_sums.len();
+            steady_sums.push(0.0);
+            let mut sum = 0.0;
+            for ((j, _), r) in l.iter().zip(steady) {
+                sum += delta[*j].abs() * r;
+                steady_sums.push(sum);
+            }
+            relative_accelerations.extend((0..=l.len()).map(|k| point_acceleration(robot, &l[..k], &delta, steady_sums[first + k])));
+        }
+        let speeds: Vec<Real> = bounds.prefix_start.windows(2).map(|w| steady_sums[w[1] - 1]).collect();
         let accelerations = bounds.levers.iter().zip(&speeds).map(|(l, speed)| point_acceleration(robot, l, &delta, *speed)).collect();
-        let relative_accelerations = bounds
-            .levers
-            .iter()
-            .zip(&steady_sums)
-            .map(|(l, sums)| (0..=l.len()).map(|k| point_acceleration(robot, &l[..k], &delta, sums[k])).collect())
-            .collect();
-        // Sized once: growing them push by push was 3 % of a motion's time on the wall.
-        let levered = RefCell::new(
-            bounds
-                .levers
-                .iter()
-                .map(|l| Levered { prefix: Vec::with_capacity(l.len() + 1), moving: Vec::with_capacity(l.len() + 1), ..Levered::default() })
-                .collect(),
-        );
+        let levered = RefCell::new(Levered { bounds: vec![TargetBound::default(); speeds.len()], prefix: vec![0.0; prefixes], moving: vec![None; prefixes] });
         Ok(JointPath {
             checker: self,
             base: pose_from_isometry(self.base_pose()),

@@ -39,6 +39,9 @@ pub(crate) struct MotionBounds {
     pub(super) grown: Vec<Vec<Vec<OnceLock<TargetShape>>>>,
     /// The joints' frames, for the motion loop's forward kinematics.
     pub(super) frames: PoseKinematics,
+    /// Where target `t`'s per-joint prefixes (`levers[t].len() + 1` of them, over its first `k`
+    /// joints at `[k]`) start in a motion's flat arrays; the last entry is their total.
+    pub(super) prefix_start: Vec<usize>,
     /// Per pair of targets `(x, y)`, at `x * targets + y`: see [`MotionBounds::unshared`].
     unshared: Vec<usize>,
     /// Growth of level 0: half the tolerance, so a level under the tolerance exists.
@@ -155,6 +158,12 @@ impl MotionBounds {
         }
         let grown = targets.iter().map(|t| t.parts.iter().map(|_| (0..LEVELS).map(|_| OnceLock::new()).collect()).collect()).collect();
         let ball = targets.iter().map(|t| target_ball(&t.parts)).collect();
+        let prefix_start = std::iter::once(0)
+            .chain(levers.iter().scan(0, |at, l| {
+                *at += l.len() + 1;
+                Some(*at)
+            }))
+            .collect();
         let n = levers.len();
         let unshared = (0..n * n)
             .map(|xy| {
@@ -162,7 +171,7 @@ impl MotionBounds {
                 levers[x].iter().take_while(|(j, _)| !levers[y].iter().any(|(k, _)| k == j)).count()
             })
             .collect();
-        MotionBounds { levers, steady, reach: reaches, ball, grown, frames: robot.pose_kinematics(), unshared, base: tolerance / 2.0 }
+        MotionBounds { levers, steady, reach: reaches, ball, grown, frames: robot.pose_kinematics(), prefix_start, unshared, base: tolerance / 2.0 }
     }
 
     /// Builds every part's grown shapes up to the level that covers `up_to` (see
