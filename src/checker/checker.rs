@@ -2,7 +2,7 @@
 //! after, and what can be read of them.
 
 use super::link_targets::LinkTargets;
-use super::motion_bounds::MotionBounds;
+use super::motion_bounds::{Ladder, MotionBounds};
 use super::self_pairs::SelfPairs;
 use crate::collision::{CollideSettings, Scene, Target, TargetReport};
 use crate::model::{Params, RobotModel};
@@ -48,6 +48,10 @@ pub struct Checker {
     pub(super) allowed: Vec<Vec<bool>>,
     /// Levers and grown parts for motion checks, built on the first motion.
     pub(super) motion: OnceLock<MotionBounds>,
+    /// The growth ladders of the robot's links, from the checker this one was made from when
+    /// only attached objects changed (see [`MotionBounds::new`]): a pick and place does not
+    /// build them again at each attach.
+    pub(super) robot_ladders: Vec<Arc<Ladder>>,
     /// The link pairs checked against each other.
     pub(super) self_pairs: SelfPairs,
     /// `moving[j]`: joint `j` takes a position from joint states and moves a checked link (itself,
@@ -130,13 +134,13 @@ impl Checker {
     }
 
     pub(crate) fn motion_bounds(&self) -> &MotionBounds {
-        self.motion.get_or_init(|| MotionBounds::new(&self.robot, &self.targets, self.params.motion_tolerance))
+        self.motion.get_or_init(|| MotionBounds::new(&self.robot, &self.targets, self.params.motion_tolerance, &self.robot_ladders))
     }
 
     /// Builds now what the motion checks otherwise build as they first need it: the motion
     /// bounds, and every link grown by each rung of the ladder up to the largest growth the
     /// loop tests (for the Panda's meshes about 0.35 s and 46 MiB, which a long run of motion
-    /// checks builds anyway; once per robot and attached objects).
+    /// checks builds anyway; once per robot: attaching or detaching objects keeps the links').
     /// The first motions are then as fast as the rest: the node does this at start, on a
     /// thread of its own, and the benchmarks before they time anything.
     pub fn prepare_motion_checks(&self) {

@@ -515,7 +515,7 @@ mod tests {
         let bounds = prepared.motion_bounds();
         let top = bounds.level(crate::checker::motion_sweep::MAX_TESTED_GROWTH);
         assert!(top > 0 && bounds.growth(top) >= crate::checker::motion_sweep::MAX_TESTED_GROWTH);
-        for levels in bounds.grown.iter().flatten() {
+        for levels in bounds.grown.iter().flat_map(|ladder| ladder.iter()) {
             assert!(levels.iter().take(top + 1).all(|l| l.get().is_some()));
             assert!(levels.iter().skip(top + 1).all(|l| l.get().is_none()));
         }

@@ -16,6 +16,9 @@ const RUNGS: usize = 4;
 /// Levels of the growth ladder: from `base` (half the tolerance) to far past any accepted size.
 const LEVELS: usize = 64 * RUNGS;
 
+/// A target's grown parts: per part, per level of the ladder, built on first use.
+pub(crate) type Ladder = Vec<Vec<OnceLock<TargetShape>>>;
+
 /// What the motion check precomputes per checked link: the lever of every joint that moves it,
 /// and its parts grown by each step of the ladder (built on first use).
 #[derive(Clone, Debug)]
@@ -35,8 +38,9 @@ pub(crate) struct MotionBounds {
     /// Per target: a point fixed to its link (link frame) and the farthest any of the target's
     /// points lies from it, for the first-order bound of `JointPath::bound`.
     pub(super) ball: Vec<(Vector, Real)>,
-    /// Per target, per part, per level: the part grown by `base · 2^level`.
-    pub(super) grown: Vec<Vec<Vec<OnceLock<TargetShape>>>>,
+    /// Per target, per part, per level: the part grown by `base · 2^level`. Shared by the
+    /// checkers whose targets are the same link with the same parts (see [`MotionBounds::new`]).
+    pub(super) grown: Vec<Arc<Ladder>>,
     /// The joints' frames, for the motion loop's forward kinematics.
     pub(super) frames: PoseKinematics,
     /// Where target `t`'s per-joint prefixes (`levers[t].len() + 1` of them, over its first `k`
@@ -107,7 +111,10 @@ pub(super) fn grow(shape: &TargetShape, pad: Real) -> TargetShape {
 }
 
 impl MotionBounds {
-    pub(crate) fn new(robot: &RobotModel, targets: &[LinkTargets], tolerance: Real) -> MotionBounds {
+    /// `kept`: the ladders of the first targets, from another checker whose first targets are
+    /// these (the robot's links, before objects were attached or detached): what either builds,
+    /// both have.
+    pub(crate) fn new(robot: &RobotModel, targets: &[LinkTargets], tolerance: Real, kept: &[Arc<Ladder>]) -> MotionBounds {
         let mut levers = Vec::with_capacity(targets.len());
         let mut steady = Vec::with_capacity(targets.len());
         let mut reaches = Vec::with_capacity(targets.len());
@@ -156,7 +163,14 @@ impl MotionBounds {
             levers.push(list);
             steady.push(own_steady);
         }
-        let grown = targets.iter().map(|t| t.parts.iter().map(|_| (0..LEVELS).map(|_| OnceLock::new()).collect()).collect()).collect();
+        let grown = targets
+            .iter()
+            .enumerate()
+            .map(|(t, parts)| match kept.get(t) {
+                Some(ladder) => Arc::clone(ladder),
+                None => Arc::new(parts.parts.iter().map(|_| (0..LEVELS).map(|_| OnceLock::new()).collect()).collect()),
+            })
+            .collect();
         let ball = targets.iter().map(|t| target_ball(&t.parts)).collect();
         let prefix_start = std::iter::once(0)
             .chain(levers.iter().scan(0, |at, l| {
@@ -179,7 +193,7 @@ impl MotionBounds {
     pub(super) fn build_ladder(&self, targets: &[LinkTargets], up_to: Real) {
         let top = self.level(up_to);
         for (t, grown) in targets.iter().zip(&self.grown) {
-            for ((shape, _), levels) in t.parts.iter().zip(grown) {
+            for ((shape, _), levels) in t.parts.iter().zip(grown.iter()) {
                 for (level, slot) in levels.iter().enumerate().take(top + 1) {
                     let _ = slot.get_or_init(|| grow(shape, self.growth(level)));
                 }

@@ -127,6 +127,12 @@ impl Checker {
             // Motion bounds and the joints a state must give follow the targets.
             checker.moving = moving_joints(&self.robot, &targets);
             checker.motion = std::sync::OnceLock::new();
+            // The robot's links keep their parts unless resized: their ladders carry over.
+            checker.robot_ladders = match self.motion.get() {
+                _ if resized => Vec::new(),
+                Some(bounds) => bounds.grown[..self.robot_targets].to_vec(),
+                None => self.robot_ladders.clone(),
+            };
             checker.targets = targets;
         }
         Ok(checker)
@@ -269,5 +275,49 @@ mod tests {
         let refusal = |id: &str| base.with_world([(id, &object_pose, &shapes[..])], &mut BodyCache::default()).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(refusal("guard_sheet").contains("names an object of the environment"), "{}", refusal("guard_sheet"));
         assert!(refusal("base_link").contains("names a link of the robot"), "{}", refusal("base_link"));
+    }
+
+    /// Attaching an object keeps the robot links' growth ladders (the same rungs, shared, none
+    /// built again) and gives the object a ladder of its own; detaching keeps them too. The
+    /// attached checker's motions answer as those of one whose ladders were all built anew.
+    #[test]
+    fn attaching_and_detaching_keep_the_robot_links_ladders() {
+        let base = Checker::from_params(Params::default()).unwrap();
+        base.prepare_motion_checks();
+        let robot_targets = base.robot_targets;
+        let link = base.targets()[robot_targets - 1].name.clone();
+        let shapes = [(WorldShape::Box([0.05, 0.05, 0.2]), Pose::from_translation(crate::math::Vector::new(0.0, 0.0, 0.1)))];
+        let attached = [Attached { id: "tool", link: &link, shapes: &shapes, touch_links: &[] }];
+        type Object<'a> = (&'a str, &'a Pose, &'a [(WorldShape, Pose)]);
+        let none: Vec<Object> = Vec::new();
+        let attach = |from: &Checker, what: &[Attached]| from.with_scene(none.clone(), what, None, &LinkSizes::default(), &mut BodyCache::default()).unwrap();
+        let with = attach(&base, &attached);
+        let fresh = attach(&Checker::from_params(Params::default()).unwrap(), &attached);
+        assert_eq!(with.targets().len(), robot_targets + 1);
+        let shared = |c: &Checker| (0..robot_targets).all(|t| Arc::ptr_eq(&c.motion_bounds().grown[t], &base.motion_bounds().grown[t]));
+        assert!(shared(&with) && !shared(&fresh));
+        assert!(with.motion_bounds().grown[robot_targets].iter().flatten().all(|rung| rung.get().is_none()), "the object's ladder is its own");
+        let detached = attach(&with, &[]);
+        assert_eq!(detached.targets().len(), robot_targets);
+        assert!(shared(&detached));
+
+        let robot = with.robot();
+        let mut rng = oorandom::Rand64::new(48);
+        let mut state = || -> Vec<f64> {
+            robot
+                .joints
+                .iter()
+                .map(|j| if j.limits.iter().all(|l| l.is_finite()) { j.limits[0] + (j.limits[1] - j.limits[0]) * rng.rand_float() } else { 0.0 })
+                .collect()
+        };
+        let mut colliding = 0;
+        for _ in 0..60 {
+            let (q0, q1) = (state(), state());
+            let (mut a, mut b) = (with.check_motion(&q0, &q1), fresh.check_motion(&q0, &q1));
+            (a.report.check_seconds, b.report.check_seconds) = (0.0, 0.0);
+            assert_eq!(a, b);
+            colliding += usize::from(a.report.in_collision);
+        }
+        assert!(colliding > 0, "some motions collide");
     }
 }
