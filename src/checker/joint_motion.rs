@@ -432,7 +432,7 @@ impl Checker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::checker::test_points::{largest_pair_change, part_points};
+    use crate::checker::test_points::{largest_pair_change, part_points, random_state};
     use crate::model::Params;
 
     fn arm() -> Checker {
@@ -464,15 +464,6 @@ mod tests {
             assert_eq!(r.error, expected);
         }
         assert!(c.check_motion(&free, &free).report.error.is_empty());
-    }
-
-    /// The bound the adaptive loop trusts, checked directly: over random motions of the bundled
-    /// arm (revolute, continuous, prismatic and mimic joints), no point of any link, sampled
-    /// along a stretch, lies farther from where it is at the stretch's middle than the bound.
-    /// Every joint within its limits (continuous ones within one turn), drawn by `draw(lo, hi)`.
-    fn random_state(robot: &RobotModel, draw: &mut impl FnMut(f64, f64) -> f64) -> Vec<f64> {
-        let pi = std::f64::consts::PI;
-        robot.joints.iter().map(|j| if j.limits.iter().all(|l| l.is_finite()) { draw(j.limits[0], j.limits[1]) } else { draw(-pi, pi) }).collect()
     }
 
     /// The motion loop's forward kinematics (glam, unvalidated) poses every link where the
@@ -568,6 +559,9 @@ mod tests {
         eprintln!("{checked} pair stretches, largest change / bound {tightest:.3}");
     }
 
+    /// The bound the adaptive loop trusts, checked directly: over random motions of the bundled
+    /// arm (revolute, continuous, prismatic and mimic joints), no point of any link, sampled
+    /// along a stretch, lies farther from where it is at the stretch's middle than the bound.
     #[test]
     fn no_point_of_a_link_moves_farther_than_its_bound() {
         let c = arm();

@@ -1,4 +1,5 @@
-//! Test support for the motion bounds: points of a checked link's parts to sample.
+//! Test support for the motion bounds: points of a checked link's parts to sample, states to
+//! move between.
 
 use crate::collision::TargetShape;
 use crate::math::{Pose, Real, Vector};
@@ -31,4 +32,11 @@ pub(crate) fn largest_pair_change(points_a: &[Vector], la: usize, points_b: &[Ve
         }
     }
     largest
+}
+
+/// A state with every joint within its limits (continuous ones within one turn), each drawn by
+/// `draw(lo, hi)`.
+pub(crate) fn random_state(robot: &crate::model::RobotModel, draw: &mut impl FnMut(f64, f64) -> f64) -> Vec<f64> {
+    let pi = std::f64::consts::PI;
+    robot.joints.iter().map(|j| if j.limits.iter().all(|l| l.is_finite()) { draw(j.limits[0], j.limits[1]) } else { draw(-pi, pi) }).collect()
 }

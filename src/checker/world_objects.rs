@@ -215,6 +215,7 @@ fn attached_pairs(params: &Params, targets: &[LinkTargets], first: usize, attach
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::checker::test_points::random_state;
     use crate::math::Vector;
     use crate::mesh::generate;
     use crate::model::{read_mesh, MeshData, PackageResolver, Params, RobotModel};
@@ -303,16 +304,10 @@ mod tests {
 
         let robot = with.robot();
         let mut rng = oorandom::Rand64::new(48);
-        let mut state = || -> Vec<f64> {
-            robot
-                .joints
-                .iter()
-                .map(|j| if j.limits.iter().all(|l| l.is_finite()) { j.limits[0] + (j.limits[1] - j.limits[0]) * rng.rand_float() } else { 0.0 })
-                .collect()
-        };
+        let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
         let mut colliding = 0;
         for _ in 0..60 {
-            let (q0, q1) = (state(), state());
+            let (q0, q1) = (random_state(robot, &mut draw), random_state(robot, &mut draw));
             let (mut a, mut b) = (with.check_motion(&q0, &q1), fresh.check_motion(&q0, &q1));
             (a.report.check_seconds, b.report.check_seconds) = (0.0, 0.0);
             assert_eq!(a, b);
