@@ -154,17 +154,17 @@ impl JointPath<'_> {
         moving: &mut [Option<(Vector, Vector)>],
     ) -> Moved {
         let robot = self.checker.robot();
+        let bounds = self.checker.motion_bounds();
         let mut axes = self.axes.borrow_mut();
         let stretch = Some((mid.to_bits(), half.to_bits()));
         if axes.stretch != stretch {
             axes.stretch = stretch;
             axes.axes.clear();
-            axes.axes.extend(robot.joints.iter().map(|joint| match poses[joint.child] {
-                Some(child) => child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z),
+            axes.axes.extend(robot.joints.iter().enumerate().map(|(j, joint)| match poses[joint.child] {
+                Some(child) => child.rotation * bounds.frames.axis(j),
                 None => Vector::ZERO,
             }));
         }
-        let bounds = self.checker.motion_bounds();
         let reach = bounds.reach[ti];
         let (centre, radius) = bounds.ball[ti];
         let centre = link * centre;
@@ -190,8 +190,8 @@ impl JointPath<'_> {
                     let off_centre = (to_centre - axis * to_centre.dot(axis)).length();
                     r.min((off_axis + reach).min(off_centre + radius) + half * below)
                 }
-                (JointKind::Prismatic, Some(child)) => {
-                    moved.velocity += child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z) * self.delta[j];
+                (JointKind::Prismatic, Some(_)) => {
+                    moved.velocity += axes.axes[j] * self.delta[j];
                     r
                 }
                 _ => {

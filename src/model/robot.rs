@@ -217,6 +217,13 @@ pub(crate) struct PoseKinematics {
     axes: Vec<crate::math::Vector>,
 }
 
+impl PoseKinematics {
+    /// Joint `j`'s axis in its child link's frame.
+    pub(crate) fn axis(&self, j: usize) -> crate::math::Vector {
+        self.axes[j]
+    }
+}
+
 impl RobotModel {
     /// The joints' frames for [`RobotModel::forward_poses`].
     pub(crate) fn pose_kinematics(&self) -> PoseKinematics {
