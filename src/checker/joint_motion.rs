@@ -119,8 +119,13 @@ pub(super) fn point_acceleration(robot: &RobotModel, levers: &[(usize, Real)], d
 /// link at `link` lies from that axis: what a lever is tightened to at the middle of a stretch.
 pub(super) fn axis_and_offset(joint: &crate::model::JointModel, child: &Pose, link: &Pose) -> (Vector, Real) {
     let axis = child.rotation * Vector::new(joint.axis.x, joint.axis.y, joint.axis.z);
-    let rel = link.translation - child.translation;
-    (axis, (rel - axis * rel.dot(axis)).length())
+    (axis, distance_from_axis(axis, child.translation, link.translation))
+}
+
+/// How far `point` lies from the line through `through` along unit `axis`.
+fn distance_from_axis(axis: Vector, through: Vector, point: Vector) -> Real {
+    let rel = point - through;
+    (rel - axis * rel.dot(axis)).length()
 }
 
 /// What the joints below a target do to it at the middle of a stretch (see `JointPath::bound`).
@@ -180,14 +185,12 @@ impl JointPath<'_> {
             let lever = match (joint.kind, poses[joint.child]) {
                 (JointKind::Revolute | JointKind::Continuous, Some(child)) => {
                     let axis = axes.axes[j];
-                    let rel = link.translation - child.translation;
-                    let off_axis = (rel - axis * rel.dot(axis)).length();
                     moved.omega += axis * self.delta[j];
                     moved.velocity += axis.cross(centre - child.translation) * self.delta[j];
                     // From the axis to the link's origin plus its reach, or to its ball's centre
                     // plus the ball's radius: both hold every point of the link at the middle.
-                    let to_centre = centre - child.translation;
-                    let off_centre = (to_centre - axis * to_centre.dot(axis)).length();
+                    let off_axis = distance_from_axis(axis, child.translation, link.translation);
+                    let off_centre = distance_from_axis(axis, child.translation, centre);
                     r.min((off_axis + reach).min(off_centre + radius) + half * below)
                 }
                 (JointKind::Prismatic, Some(_)) => {
