@@ -361,8 +361,13 @@ fn a_state_the_node_falls_behind_on_is_still_covered_by_the_next_report() {
             for _ in 0..CS {
                 messages.push(msg(2, true));
             }
-            // Resumed, the node finds them all waiting; the peer waits for its reports.
-            messages.push(json!({"signal": "CONT", "pid": pid, "burst": false}));
+            // Resumed, the node finds them all waiting; the peer waits for the report of the
+            // last C, so that the next round does not stop the node with states of this one still
+            // in its reader, where the next round's 91 could push them out of the 100 it keeps
+            // (covered by nothing: the test's count of states received fails). Before, the peer
+            // went on 50 ms after the round's first report; a CI host once failed this test.
+            let last = messages.last().unwrap()["stamp"].as_i64().unwrap();
+            messages.push(json!({"signal": "CONT", "pid": pid, "burst": false, "until": last, "wait": 5}));
         }
         messages
     };
@@ -416,13 +421,13 @@ fn a_state_the_node_falls_behind_on_is_still_covered_by_the_next_report() {
             (AS + 1 + CS) * ROUNDS
         );
         // Resumed with 91 states waiting, the node answers the newest 63 of a turn on their own
-        // and the older ones with one report: at least a third of the rounds must show that for
-        // B. RustDDS reads the waiting datagrams in batches and the node takes each batch's
+        // and the older ones with one report: at least a quarter of the rounds must show that
+        // for B. RustDDS reads the waiting datagrams in batches and the node takes each batch's
         // states together once it is handled (RustDDS change 13): B may come in a batch of its
-        // own, or with too few after it (measured, with B after 15 A: 15 to 23 of 30 with the
-        // node's loop taking them; answered on the receiving thread, 22 and 24 of 30; woken per
-        // sample there instead of per batch, 0).
-        assert!(skipped_b >= ROUNDS / 3, "B was reported on its own in {} of {ROUNDS} rounds: {reports:?}", ROUNDS - skipped_b);
+        // own, or with too few after it (measured, with B after 15 A: 12 to 27 of 30 over 30
+        // idle runs of each mode, 22 to 30 with the host busy; answered on the receiving
+        // thread, 22 and 24 of 30; woken per sample there instead of per batch, 0).
+        assert!(skipped_b >= ROUNDS / 4, "B was reported on its own in {} of {ROUNDS} rounds: {reports:?}", ROUNDS - skipped_b);
         assert!(
             reports.len() >= ROUNDS * (CS - 20),
             "{} reports for {ROUNDS} rounds of {} states: the states waiting were not answered one by one",

@@ -78,7 +78,9 @@ def live(req):
             for st in d.status:
                 diagnostics.update({kv.key: kv.value for kv in st.values})
 
-    def collect(wait):
+    def collect(wait, until=None):
+        # `until`: a stamp; the reports keep being collected until one at or after it arrives
+        # (the node has caught up), then as below.
         end = time.time() + wait
         got = []
         while time.time() < end:
@@ -87,7 +89,7 @@ def live(req):
                             "in_collision": bool(r.in_collision), "error": r.error, "motion": bool(r.motion), "fraction": r.fraction,
                             "contacts": [{"link_name": c.link_name, "object_name": c.object_name, "triangle": int(c.triangle), "depth": c.depth}
                                          for c in r.contacts]})
-            if got:
+            if got and (until is None or any(g["stamp"] >= until for g in got)):
                 # Anything else already on its way arrives within a few ms.
                 end = min(end, time.time() + 0.05)
             time.sleep(0.005)
@@ -115,7 +117,7 @@ def live(req):
     for m in rest:
         send(m)
         if not m.get("burst"):
-            reports.extend(collect(0.5))
+            reports.extend(collect(m.get("wait", 0.5), m.get("until")))
     time.sleep(1.5)  # a status after the last message
     drain_diag()
     return {"reports": reports, "diagnostics": diagnostics}
