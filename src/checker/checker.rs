@@ -147,6 +147,13 @@ impl Checker {
         self.motion_bounds().build_ladder(&self.targets, super::motion_sweep::MAX_TESTED_GROWTH);
     }
 
+    /// Whether [`Checker::prepare_motion_checks`] has nothing left to build (false before the
+    /// motion bounds exist).
+    #[cfg(test)]
+    pub(crate) fn motion_checks_prepared(&self) -> bool {
+        self.motion.get().is_some_and(|bounds| bounds.ladder_built(super::motion_sweep::MAX_TESTED_GROWTH))
+    }
+
     /// Target `ti` (a part of a checked link, posed) against the scene, without the objects the
     /// link may touch.
     pub(crate) fn collide_target(&self, ti: usize, target: &Target, settings: &CollideSettings) -> TargetReport {

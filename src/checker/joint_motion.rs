@@ -505,7 +505,9 @@ mod tests {
     #[test]
     fn a_prepared_checker_has_its_ladder_and_answers_as_an_unprepared_one() {
         let (prepared, lazy) = (arm(), arm());
+        assert!(!prepared.motion_checks_prepared());
         prepared.prepare_motion_checks();
+        assert!(prepared.motion_checks_prepared());
         let bounds = prepared.motion_bounds();
         let top = bounds.level(crate::checker::motion_sweep::MAX_TESTED_GROWTH);
         assert!(top > 0 && bounds.growth(top) >= crate::checker::motion_sweep::MAX_TESTED_GROWTH);

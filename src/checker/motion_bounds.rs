@@ -201,6 +201,14 @@ impl MotionBounds {
         }
     }
 
+    /// Whether every part's grown shapes up to the level that covers `up_to` are built (what
+    /// [`MotionBounds::build_ladder`] leaves).
+    #[cfg(test)]
+    pub(super) fn ladder_built(&self, up_to: Real) -> bool {
+        let top = self.level(up_to);
+        self.grown.iter().flat_map(|ladder| ladder.iter()).all(|levels| levels.iter().take(top + 1).all(|slot| slot.get().is_some()))
+    }
+
     /// How many of target `x`'s joints (nearest first) come before the first that moves target
     /// `y` too: the joints a pair's two links share are the end of each one's list, and they move
     /// the pair as one body.

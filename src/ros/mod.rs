@@ -19,6 +19,7 @@ mod diagnostics;
 mod discovery_range;
 mod interfaces;
 mod memory_return;
+mod motion_ladder;
 mod msg_impls;
 mod node_run;
 mod node_state;

@@ -6,6 +6,7 @@
 use super::background::Background;
 use super::interfaces::{Event, Events, Interfaces};
 use super::memory_return;
+use super::motion_ladder::MotionLadder;
 use super::node_state::{NodeState, PendingScene};
 use super::param_services::{ros_mapping, ParamServers};
 use super::param_values::{parameter_options, ReadOnly};
@@ -172,12 +173,9 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     // The robot may come as a robot_description: an SRDF meant for it waits for it.
     let pipeline = Pipeline::new_expecting_description(params)?;
     // The motion checks' grown links, built beside the start rather than by the first requests
-    // (a request that needs one first waits only for that one).
-    let prepared = Arc::clone(pipeline.checker());
-    let _detached = std::thread::Builder::new()
-        .name("motion ladder".into())
-        .spawn(move || prepared.prepare_motion_checks())
-        .context("cannot start the motion ladder's thread")?;
+    // (a request that needs one first waits only for that one); again for each new robot.
+    let ladder = MotionLadder::start().context("cannot start the motion ladder's thread")?;
+    ladder.prepare(pipeline.checker());
     let (dp, domain, discovery) = participant()?;
     let context = Context::from_domain_participant(dp).map_err(|e| anyhow!("ROS context: {e:?}"))?;
     let namespace = opts.ros_args.namespace.clone().unwrap_or_else(|| "/".into());
@@ -196,7 +194,7 @@ pub fn run(params: Params, opts: &RunOptions) -> Result<()> {
     let workers = Workers::start()?;
     let background = Background::start().context("cannot start the background thread")?;
     let spinner = node.spinner().map_err(|e| anyhow!("spinner: {e:?}"))?;
-    let state = NodeState::new(pipeline, node.fully_qualified_name(), stop.summary.clone());
+    let state = NodeState::new(pipeline, ladder, node.fully_qualified_name(), stop.summary.clone());
     let checking = Arc::new(Mutex::new(Checking::new(state, io.clone())));
     let (on_receive, states_turns) = OnReceive::new(&checking, &io, changes.clone());
     let running = Running {

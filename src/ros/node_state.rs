@@ -7,6 +7,7 @@ use super::description_msg::DescriptionMsg;
 use super::diagnostics::{diagnostics, NodeStats};
 use super::interfaces::{Event, Interfaces};
 use super::memory_return::MemoryReturn;
+use super::motion_ladder::MotionLadder;
 use super::rate_limited_log::RateLimitedLog;
 use super::workers::Workers;
 use crate::checker::Checker;
@@ -82,6 +83,8 @@ impl PendingScene {
 /// The node's state between messages.
 pub(super) struct NodeState {
     pipeline: Pipeline,
+    /// Prepares the motion checks of each robot put in force here.
+    ladder: MotionLadder,
     pub(super) stats: NodeStats,
     log: RateLimitedLog,
     sim_time: Option<Time>,
@@ -97,9 +100,10 @@ pub(super) struct NodeState {
 
 impl NodeState {
     /// The state of node `fqn` at start; `summary` is where [`NodeState::refresh_summary`] writes.
-    pub(super) fn new(pipeline: Pipeline, fqn: String, summary: Arc<Mutex<String>>) -> NodeState {
+    pub(super) fn new(pipeline: Pipeline, ladder: MotionLadder, fqn: String, summary: Arc<Mutex<String>>) -> NodeState {
         NodeState {
             pipeline,
+            ladder,
             stats: NodeStats::default(),
             log: RateLimitedLog::default(),
             sim_time: None,
@@ -224,6 +228,7 @@ impl NodeState {
                         s.cells,
                         s.build_seconds * 1e3
                     );
+                    self.ladder.prepare(self.pipeline.checker());
                     self.publish_cells(io);
                 }
                 Err(e) => self.log.warn("params", || format!("parameter change not applied, keeping the current model: {e}")),
@@ -335,6 +340,7 @@ impl NodeState {
             Ok(()) => {
                 let s = self.pipeline.checker().summary();
                 println!("thickness_collision: robot from {}: {} links, {} checked", io.names.description, s.robot_links, s.checked_links);
+                self.ladder.prepare(self.pipeline.checker());
                 self.description_error = None;
                 self.publish_cells(io);
             }
