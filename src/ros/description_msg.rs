@@ -1,8 +1,18 @@
 //! `robot_description` (and `robot_description_semantic`) as the node decodes it: a
-//! `std_msgs/msg/String` whose size bound is checked before the text is copied out of the sample.
+//! `std_msgs/msg/String` whose size bound is checked before the text is copied out of the sample,
+//! and the line a refused one is reported with.
 
 use crate::limits::MAX_DESCRIPTION_BYTES;
 use serde::{Deserialize, Serialize};
+
+/// The line a refused description is logged and diagnosed with: the topic once, then why. The
+/// error names its source (`/robot_description topic: ...`) when it comes from the text itself;
+/// that prefix is dropped, as the line already starts with the topic.
+pub(super) fn refusal_line(topic: &str, source: &str, what_stays: &str, error: &str) -> String {
+    let error = error.replace('\n', " ");
+    let reason = error.strip_prefix(source).and_then(|r| r.strip_prefix(": ")).unwrap_or(&error);
+    format!("{topic} rejected, {what_stays}: {reason}")
+}
 
 /// `std_msgs/msg/String` on `robot_description`, its length checked before the text is copied out
 /// of the DDS sample: text past [`MAX_DESCRIPTION_BYTES`] comes back as
@@ -104,5 +114,15 @@ mod tests {
         let mut bad = cdr("<robot/>");
         bad[5] = 0xff;
         assert!(cdr_encoding::from_bytes::<DescriptionMsg, LittleEndian>(&bad).is_err());
+    }
+
+    #[test]
+    fn a_refused_description_names_its_topic_once() {
+        let source = "/robot_description topic";
+        let line = refusal_line("/robot_description", source, "keeping the current robot", "/robot_description topic: malformed URDF: x\ny");
+        assert_eq!(line, "/robot_description rejected, keeping the current robot: malformed URDF: x y");
+        // An error about another file keeps its own prefix.
+        let line = refusal_line("/robot_description", source, "keeping the current robot", "env.urdf: link 'a': bad");
+        assert_eq!(line, "/robot_description rejected, keeping the current robot: env.urdf: link 'a': bad");
     }
 }

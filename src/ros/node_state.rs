@@ -3,7 +3,7 @@
 //! answer, and nothing here waits: the loop (`node_run.rs`) or the receiving thread
 //! (`states_on_receive.rs`) calls a handler with the state held.
 
-use super::description_msg::DescriptionMsg;
+use super::description_msg::{refusal_line, DescriptionMsg};
 use super::diagnostics::{diagnostics, NodeStats};
 use super::interfaces::{Event, Interfaces};
 use super::memory_return::MemoryReturn;
@@ -35,15 +35,6 @@ const SEPARATE_REPORTS: usize = 64;
 /// Contact markers fade half a second after the last report: a node whose input stopped shows no
 /// stale contacts.
 const CONTACT_MARKER_LIFETIME: crate::msgs::DurationMsg = crate::msgs::DurationMsg { sec: 0, nanosec: 500_000_000 };
-
-/// The line a refused description is logged and diagnosed with: the topic once, then why. The
-/// error names its source (`/robot_description topic: ...`) when it comes from the text itself;
-/// that prefix is dropped, as the line already starts with the topic.
-fn refusal_line(topic: &str, source: &str, what_stays: &str, error: &str) -> String {
-    let error = error.replace('\n', " ");
-    let reason = error.strip_prefix(source).and_then(|r| r.strip_prefix(": ")).unwrap_or(&error);
-    format!("{topic} rejected, {what_stays}: {reason}")
-}
 
 /// A planning-scene input accepted, its cells still to build.
 pub(super) struct PendingScene {
@@ -501,20 +492,5 @@ impl NodeState {
         if let Ok(mut summary) = self.summary.lock() {
             *summary = line;
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_refused_description_names_its_topic_once() {
-        let source = "/robot_description topic";
-        let line = refusal_line("/robot_description", source, "keeping the current robot", "/robot_description topic: malformed URDF: x\ny");
-        assert_eq!(line, "/robot_description rejected, keeping the current robot: malformed URDF: x y");
-        // An error about another file keeps its own prefix.
-        let line = refusal_line("/robot_description", source, "keeping the current robot", "env.urdf: link 'a': bad");
-        assert_eq!(line, "/robot_description rejected, keeping the current robot: env.urdf: link 'a': bad");
     }
 }
