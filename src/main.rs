@@ -70,7 +70,8 @@ enum Command {
         #[arg(long)]
         show_params: bool,
         /// One `trajectory_msgs/JointTrajectory` (YAML or JSON with the message's field names, as
-        /// `ros2 topic echo --once` prints it), checked as `joint_trajectory_controller` executes
+        /// `ros2 topic echo --once` prints it), or a `FollowJointTrajectory` goal holding one
+        /// (its `path_tolerance` the tube), checked as `joint_trajectory_controller` executes
         /// it, from `--joints` (else from its first point, at rest). Exit 0 free or colliding, 2
         /// when it is refused or cannot be read.
         #[arg(long, conflicts_with = "states")]
@@ -80,7 +81,7 @@ enum Command {
         #[arg(long, requires = "trajectory", default_value = "spline")]
         interpolation: String,
         /// With `--trajectory`: how far each joint may stray from the path, one value per
-        /// `joint_names` entry, comma-separated (radians / metres).
+        /// `joint_names` entry, comma-separated (radians / metres); in place of a goal's.
         #[arg(long, requires = "trajectory", value_delimiter = ',')]
         path_tolerance: Vec<f64>,
     },

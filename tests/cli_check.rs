@@ -264,3 +264,46 @@ fn a_trajectory_as_ros2_topic_pub_examples_write_it_is_read_as_ros_reads_it() {
     let time = v["time"].as_f64().unwrap();
     assert!(time > 1.0 && time <= 3.0, "{v}");
 }
+
+/// `check --trajectory` on a `FollowJointTrajectory` goal (as `ros2 action send_goal` takes one):
+/// its trajectory checked in the tube its `path_tolerance` gives, the same answer as the bare
+/// trajectory with that tube in `--path-tolerance`; a tolerance of 0 (the controller's default,
+/// unknown here) warned about and no tube for that joint; -1 (no bound: no tube to prove) refused
+/// with exit 2, unless `--path-tolerance` gives the tube instead.
+#[test]
+fn a_follow_joint_trajectory_goal_is_checked_in_its_tube() {
+    let names = "[shoulder_pan_joint, shoulder_lift_joint, elbow_joint, wrist_1_joint, wrist_2_joint, wrist_3_joint, finger_left_joint, finger_right_joint]";
+    let points = "  points:\n  - positions: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]\n    time_from_start: {sec: 1}\n  - positions: [0.0, 0.3, 0.3, 0.0, 0.0, 0.0, 0.0, 0.0]\n    time_from_start: {sec: 3}\n";
+    let bare = tmp("goal_bare.yaml");
+    std::fs::write(&bare, format!("joint_names: {names}\n{}", points.replace("\n  ", "\n").trim_start())).unwrap();
+    let goal = |name: &str, lift: &str| {
+        let path = tmp(name);
+        let text = format!(
+            "trajectory:\n  joint_names: {names}\n{points}path_tolerance:\n- {{name: elbow_joint, position: 0.0, velocity: 0.0, acceleration: 0.0}}\n- {{name: shoulder_lift_joint, position: {lift}, velocity: 0.0, acceleration: 0.0}}\ngoal_tolerance: []\ngoal_time_tolerance: {{sec: 0, nanosec: 0}}\n"
+        );
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let run = |file: &PathBuf, tube: Option<&str>| {
+        let mut cmd = bin();
+        cmd.args(["check", "--trajectory", file.to_str().unwrap(), "--json"]);
+        if let Some(tube) = tube {
+            cmd.args(["--path-tolerance", tube]);
+        }
+        cmd.output().unwrap()
+    };
+    let mut answers = Vec::new();
+    for lift in ["0.05", "0.9"] {
+        let from_goal = run(&goal(&format!("goal_{lift}.yaml"), lift), None);
+        let stderr = String::from_utf8_lossy(&from_goal.stderr).into_owned();
+        assert!(stderr.contains("warning:") && stderr.contains("'elbow_joint' is 0") && stderr.contains("--path-tolerance"), "{stderr}");
+        let from_goal = ok(from_goal);
+        assert_eq!(from_goal, ok(run(&bare, Some(&format!("0,{lift},0,0,0,0,0,0")))), "tolerance {lift}");
+        answers.push(from_goal);
+    }
+    // The tube reaches something the narrow one does not: the goal's tolerance is used.
+    assert_ne!(answers[0], answers[1]);
+    let unbounded = goal("goal_unbounded.yaml", "-1.0");
+    err(run(&unbounded, None), &["goal_unbounded.yaml", "'shoulder_lift_joint' is -1", "--path-tolerance"]);
+    assert_eq!(ok(run(&unbounded, Some("0,0.9,0,0,0,0,0,0"))), answers[1]);
+}

@@ -16,7 +16,18 @@ pub fn check_trajectory(args: &ModelArgs, file: &Path, joints: Option<&str>, int
         Interpolation::Executed => String::new(),
         Interpolation::Linear => "linear".to_owned(),
     };
-    let trajectory = read_trajectory_file(file).map_err(|e| anyhow!(e))?;
+    let read = read_trajectory_file(file).map_err(|e| anyhow!(e))?;
+    // `--path-tolerance` is the tube when given, in place of a goal's.
+    let path_tolerance = if path_tolerance.is_empty() {
+        let (tolerance, notes) = read.path_tolerance().map_err(|e| anyhow!("{}: {e} (give the tube with --path-tolerance)", file.display()))?;
+        for note in notes {
+            eprintln!("warning: {}: {note} (give it with --path-tolerance)", file.display());
+        }
+        tolerance
+    } else {
+        path_tolerance
+    };
+    let trajectory = read.trajectory;
     let mut pipeline = super::load::pipeline(args)?;
     super::check::print_loaded(&pipeline);
     let start = start_state(&trajectory, joints)?;

@@ -383,7 +383,7 @@ pub(crate) struct DiagnosticArray {
 pub(crate) const MAX_TRAJECTORY_ENTRIES: usize = 65_536;
 
 /// A trajectory sequence of at most [`MAX_TRAJECTORY_ENTRIES`], refused as soon as it runs past.
-fn bounded_trajectory_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
+pub(crate) fn bounded_trajectory_seq<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Vec<T>, D::Error> {
     bounded::bounded_vec(d, MAX_TRAJECTORY_ENTRIES, "trajectory field")
 }
 

@@ -39,7 +39,7 @@ pub(crate) use self::link_transforms::link_transforms;
 pub(crate) use self::scene_input::{BuiltScene, ScenePlan};
 pub(crate) use self::trajectory::TrajectoryJob;
 pub use self::trajectory::{Outcome, APPROACH_SEGMENT};
-pub use self::trajectory_file::{read_trajectory_file, MAX_TRAJECTORY_FILE_BYTES};
+pub use self::trajectory_file::{read_trajectory_file, TrajectoryFile, MAX_TRAJECTORY_FILE_BYTES};
 pub use self::trajectory_plan::Interpolation;
 pub use self::trajectory_stream::{outcome_json, StreamedTrajectory, TrajectoryStream};
 #[cfg(feature = "ros")]
