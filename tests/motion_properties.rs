@@ -17,22 +17,13 @@ mod common;
 use oorandom::Rand64;
 use thickness_collision::checker::Checker;
 use thickness_collision::collision::TargetShape;
-use thickness_collision::model::{InputFiles, Params};
 
 const REACH: f64 = 1.2;
 const STEP: f64 = 1e-3;
 const MOTIONS: usize = 2_000;
 
 fn panda() -> Checker {
-    let erd = common::example_robot_data();
-    let params = Params {
-        package_map: vec![format!("example-robot-data={}", erd.display())],
-        // Raised 5 mm off the table it stands on (a link resting on the table collides with it).
-        robot_base_pose: vec![0.0, 0.0, 0.005, 0.0, 0.0, 0.0],
-        input_files: InputFiles { robot: Some(erd.join("robots/panda_description/urdf/panda.urdf")), environment: None },
-        ..Params::default()
-    };
-    Checker::from_params(params).unwrap()
+    Checker::from_params(common::panda_params()).unwrap()
 }
 
 #[test]

@@ -23,23 +23,13 @@ mod common;
 use oorandom::Rand64;
 use thickness_collision::checker::Checker;
 use thickness_collision::collision::TargetShape;
-use thickness_collision::model::{InputFiles, Params};
+use thickness_collision::model::Params;
 use thickness_collision::msgs::{CheckTrajectoryRequest, CheckTrajectoryResponse, DurationMsg, JointState, JointTrajectory, JointTrajectoryPoint};
 use thickness_collision::pipeline::Pipeline;
 
 const REACH: f64 = 1.2;
 const STEP: f64 = 1e-3;
 const TRAJECTORIES: usize = 150;
-
-fn panda_params() -> Params {
-    let erd = common::example_robot_data();
-    Params {
-        package_map: vec![format!("example-robot-data={}", erd.display())],
-        robot_base_pose: vec![0.0, 0.0, 0.005, 0.0, 0.0, 0.0],
-        input_files: InputFiles { robot: Some(erd.join("robots/panda_description/urdf/panda.urdf")), environment: None },
-        ..Params::default()
-    }
-}
 
 /// One end of a segment: positions, velocities and accelerations (per second; empty: not given).
 #[derive(Clone, Debug)]
@@ -181,7 +171,7 @@ fn request(names: &[String], points: &[(End, f64)], interpolation: &str) -> Chec
 
 #[test]
 fn executed_trajectories_agree_with_dense_sampling() {
-    let mut pipeline = Pipeline::new(panda_params()).unwrap();
+    let mut pipeline = Pipeline::new(common::panda_params()).unwrap();
     let c = pipeline.checker().clone();
     let robot = c.robot();
     let names: Vec<String> = (1..=7).map(|i| format!("panda_joint{i}")).collect();

@@ -155,6 +155,18 @@ pub fn example_robot_data() -> PathBuf {
     dir
 }
 
+/// The Panda from example-robot-data without an environment, raised 5 mm off the table it stands
+/// on (a link resting on the table collides with it).
+pub fn panda_params() -> thickness_collision::model::Params {
+    let erd = example_robot_data();
+    thickness_collision::model::Params {
+        package_map: vec![format!("example-robot-data={}", erd.display())],
+        robot_base_pose: vec![0.0, 0.0, 0.005, 0.0, 0.0, 0.0],
+        input_files: thickness_collision::model::InputFiles { robot: Some(erd.join("robots/panda_description/urdf/panda.urdf")), environment: None },
+        ..thickness_collision::model::Params::default()
+    }
+}
+
 /// The robot URDF at `rel` inside example-robot-data, with the package map that resolves it.
 pub fn erd_robot(rel: &str) -> (PathBuf, Vec<String>) {
     let root = example_robot_data();
