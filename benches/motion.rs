@@ -65,7 +65,7 @@ fn main() {
             for &j in &arm {
                 let [lo, hi] = robot.joints[j].limits;
                 q0[j] = lo + (hi - lo) * rng.rand_float();
-                let d = (0.1 + 0.9 * rng.rand_float()) * if rng.rand_u64() % 2 == 0 { 1.0 } else { -1.0 };
+                let d = (0.1 + 0.9 * rng.rand_float()) * if rng.rand_u64().is_multiple_of(2) { 1.0 } else { -1.0 };
                 q1[j] = (q0[j] + d).clamp(lo, hi);
             }
             (q0, q1)

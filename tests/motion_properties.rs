@@ -56,7 +56,7 @@ fn motions_agree_with_dense_sampling() {
         for &j in &arm {
             let [lo, hi] = robot.joints[j].limits;
             let a = lo + (hi - lo) * rng.rand_float();
-            let d = (0.05 + 0.45 * rng.rand_float()) * if rng.rand_u64() % 2 == 0 { 1.0 } else { -1.0 };
+            let d = (0.05 + 0.45 * rng.rand_float()) * if rng.rand_u64().is_multiple_of(2) { 1.0 } else { -1.0 };
             q0[j] = a;
             q1[j] = (a + d).clamp(lo, hi);
         }

@@ -515,7 +515,7 @@ fn front_and_both_mirror_back() {
         assert!((lo - b.normal_range()[0]).abs() < 1e-12 && (hi - f.normal_range()[1]).abs() < 1e-12);
         // Every point of either one-sided cell lies in the two-sided one.
         for _ in 0..20 {
-            let (cell, w) = if rng.rand_u64() % 2 == 0 { (b, rng.rand_float()) } else { (f, rng.rand_float()) };
+            let (cell, w) = if rng.rand_u64().is_multiple_of(2) { (b, rng.rand_float()) } else { (f, rng.rand_float()) };
             let (u, v) = (rng.rand_float() * 0.5, rng.rand_float() * 0.5);
             let bot = cell.back_cap[0] + (cell.back_cap[1] - cell.back_cap[0]) * u + (cell.back_cap[2] - cell.back_cap[0]) * v;
             let top = cell.front_cap[0] + (cell.front_cap[1] - cell.front_cap[0]) * u + (cell.front_cap[2] - cell.front_cap[0]) * v;

@@ -348,7 +348,7 @@ mod tests {
                 let (lo, hi) = if lo.is_finite() && hi.is_finite() { (lo, hi) } else { (-3.0, 3.0) };
                 let (p0, mut p1) = (draw(lo, hi), draw(lo, hi));
                 let (mut v0, mut v1, a0, a1) = (draw(-2.0, 2.0), draw(-2.0, 2.0), draw(-8.0, 8.0), draw(-8.0, 8.0));
-                if case % 5 == 0 {
+                if case.is_multiple_of(5) {
                     (p1, v0, v1) = (p0, 2.0 * duration, -2.0 * duration);
                 }
                 match case % 3 {
@@ -358,7 +358,7 @@ mod tests {
                 }
             })
             .collect();
-        let tolerance = if case % 2 == 0 { Vec::new() } else { robot.joints.iter().map(|_| draw(0.0, 0.05)).collect() };
+        let tolerance = if case.is_multiple_of(2) { Vec::new() } else { robot.joints.iter().map(|_| draw(0.0, 0.05)).collect() };
         SplineSegment { joints, tolerance }
     }
 

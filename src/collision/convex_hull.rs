@@ -90,7 +90,7 @@ fn start_bin(dir: Vector) -> usize {
 
 /// The direction through point `(u, v)` (each in `[-1, 1]`) of a cube-map face (not normalised).
 fn cube_direction(face: usize, u: Real, v: Real) -> Vector {
-    let s = if face % 2 == 0 { 1.0 } else { -1.0 };
+    let s = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
     match face / 2 {
         0 => Vector::new(s, u, v),
         1 => Vector::new(v, s, u),

@@ -167,7 +167,7 @@ mod tests {
             kind: 7,
             action: 3,
             lifetime: DurationMsg { sec: 1, nanosec: 2 },
-            frame_locked: k % 2 == 0,
+            frame_locked: k.is_multiple_of(2),
             points: vec![Point { x: 0.1, y: 0.2, z: 0.3 }; k],
             colors: vec![ColorRgba { r: 1.0, g: 0.5, b: 0.0, a: 1.0 }; k],
             uv_coordinates: vec![UvCoordinate { u: 0.5, v: 0.25 }; k % 3],

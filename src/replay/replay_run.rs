@@ -221,7 +221,7 @@ impl<'a> Replayer<'a> {
     /// One bag message, in storage order.
     fn message(&mut self, m: BagMessage) -> Result<(), ReplayError> {
         self.read += 1;
-        if self.read % 1024 == 0 {
+        if self.read.is_multiple_of(1024) {
             self.warnings.observer.progress(self.read);
         }
         let t0 = *self.t0.get_or_insert(m.log_time);

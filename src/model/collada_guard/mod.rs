@@ -64,7 +64,7 @@ pub(crate) fn check_collada(bytes: &[u8]) -> Result<(), String> {
 /// byte-order mark, or UTF-16 with one.
 fn decode(bytes: &[u8]) -> Result<Cow<'_, str>, String> {
     let utf16 = |rest: &[u8], be: bool| -> Result<Cow<'_, str>, String> {
-        if rest.len() % 2 != 0 {
+        if !rest.len().is_multiple_of(2) {
             return Err("invalid UTF-16: odd number of bytes".to_owned());
         }
         let units = rest.chunks_exact(2).map(|c| if be { u16::from_be_bytes([c[0], c[1]]) } else { u16::from_le_bytes([c[0], c[1]]) });
