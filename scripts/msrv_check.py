@@ -15,13 +15,14 @@ def version(v):
 
 meta = json.loads(subprocess.run(["cargo", "metadata", "--format-version", "1", "--locked"], check=True, capture_output=True, text=True).stdout)
 members = set(meta["workspace_members"])
+nodes = {n["id"]: n for n in meta["resolve"]["nodes"]}
+packages = {p["id"]: p for p in meta["packages"]}
 failures = 0
 for member in (p for p in meta["packages"] if p["id"] in members):
     declared = member.get("rust_version")
     if not declared:
         continue
     # Every package the member depends on, transitively, normal and build dependencies.
-    nodes = {n["id"]: n for n in meta["resolve"]["nodes"]}
     seen, todo = set(), [member["id"]]
     while todo:
         node = nodes[todo.pop()]
@@ -29,7 +30,6 @@ for member in (p for p in meta["packages"] if p["id"] in members):
             if any(k["kind"] in (None, "build") for k in dep["dep_kinds"]) and dep["pkg"] not in seen:
                 seen.add(dep["pkg"])
                 todo.append(dep["pkg"])
-    packages = {p["id"]: p for p in meta["packages"]}
     needs = [(packages[i]["rust_version"], packages[i]["name"], packages[i]["version"]) for i in seen if packages[i].get("rust_version")]
     newest = max(needs, key=lambda n: version(n[0]), default=None)
     if newest and version(newest[0]) > version(declared):

@@ -435,7 +435,7 @@ impl Checker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::checker::test_points::{largest_pair_change, part_points, random_state};
+    use crate::checker::test_points::{assert_same_motions, largest_pair_change, part_points, random_state};
     use crate::model::Params;
 
     fn arm() -> Checker {
@@ -511,23 +511,11 @@ mod tests {
         let bounds = prepared.motion_bounds();
         let top = bounds.level(crate::checker::motion_sweep::MAX_TESTED_GROWTH);
         assert!(top > 0 && bounds.growth(top) >= crate::checker::motion_sweep::MAX_TESTED_GROWTH);
+        // Every rung up to `top` is built (asserted above), none above it.
         for levels in bounds.grown.iter().flat_map(|ladder| ladder.iter()) {
-            assert!(levels.iter().take(top + 1).all(|l| l.get().is_some()));
             assert!(levels.iter().skip(top + 1).all(|l| l.get().is_none()));
         }
-        let robot = prepared.robot();
-        let mut rng = oorandom::Rand64::new(47);
-        let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
-        let mut colliding = 0;
-        for _ in 0..60 {
-            let (q0, q1) = (random_state(robot, &mut draw), random_state(robot, &mut draw));
-            let (mut a, mut b) = (prepared.check_motion(&q0, &q1), lazy.check_motion(&q0, &q1));
-            // The report's own clock is the one field that may differ.
-            (a.report.check_seconds, b.report.check_seconds) = (0.0, 0.0);
-            assert_eq!(a, b);
-            colliding += usize::from(a.report.in_collision);
-        }
-        assert!(colliding > 0, "some motions collide");
+        assert!(assert_same_motions(&prepared, &lazy, 47, 60) > 0, "some motions collide");
     }
 
     /// The self pairs' bound, checked directly: within a stretch, no distance between a point of

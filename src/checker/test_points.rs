@@ -1,5 +1,5 @@
 //! Test support for the motion bounds: points of a checked link's parts to sample, states to
-//! move between.
+//! move between, two checkers' answers compared.
 
 use crate::collision::TargetShape;
 use crate::math::{Pose, Real, Vector};
@@ -39,4 +39,23 @@ pub(crate) fn largest_pair_change(points_a: &[Vector], la: usize, points_b: &[Ve
 pub(crate) fn random_state(robot: &crate::model::RobotModel, draw: &mut impl FnMut(f64, f64) -> f64) -> Vec<f64> {
     let pi = std::f64::consts::PI;
     robot.joints.iter().map(|j| if j.limits.iter().all(|l| l.is_finite()) { draw(j.limits[0], j.limits[1]) } else { draw(-pi, pi) }).collect()
+}
+
+/// Asserts that `a` and `b` answer `motions` random motions of `a`'s robot (seeded by `seed`)
+/// the same, but for the report's own clock; returns how many collide, so a caller can require
+/// that some do.
+pub(crate) fn assert_same_motions(a: &crate::checker::Checker, b: &crate::checker::Checker, seed: u64, motions: usize) -> usize {
+    let robot = a.robot();
+    let mut rng = oorandom::Rand64::new(seed.into());
+    let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
+    let mut colliding = 0;
+    for _ in 0..motions {
+        let (q0, q1) = (random_state(robot, &mut draw), random_state(robot, &mut draw));
+        let (mut x, mut y) = (a.check_motion(&q0, &q1), b.check_motion(&q0, &q1));
+        // The report's own clock is the one field that may differ.
+        (x.report.check_seconds, y.report.check_seconds) = (0.0, 0.0);
+        assert_eq!(x, y, "from {q0:?} to {q1:?}");
+        colliding += usize::from(x.report.in_collision);
+    }
+    colliding
 }

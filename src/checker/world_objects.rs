@@ -215,7 +215,7 @@ fn attached_pairs(params: &Params, targets: &[LinkTargets], first: usize, attach
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::checker::test_points::random_state;
+    use crate::checker::test_points::assert_same_motions;
     use crate::math::Vector;
     use crate::mesh::generate;
     use crate::model::{read_mesh, MeshData, PackageResolver, Params, RobotModel};
@@ -302,17 +302,6 @@ mod tests {
         assert_eq!(detached.targets().len(), robot_targets);
         assert!(shared(&detached));
 
-        let robot = with.robot();
-        let mut rng = oorandom::Rand64::new(48);
-        let mut draw = |lo: f64, hi: f64| lo + (hi - lo) * rng.rand_float();
-        let mut colliding = 0;
-        for _ in 0..60 {
-            let (q0, q1) = (random_state(robot, &mut draw), random_state(robot, &mut draw));
-            let (mut a, mut b) = (with.check_motion(&q0, &q1), fresh.check_motion(&q0, &q1));
-            (a.report.check_seconds, b.report.check_seconds) = (0.0, 0.0);
-            assert_eq!(a, b);
-            colliding += usize::from(a.report.in_collision);
-        }
-        assert!(colliding > 0, "some motions collide");
+        assert!(assert_same_motions(&with, &fresh, 48, 60) > 0, "some motions collide");
     }
 }
